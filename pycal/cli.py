@@ -1,0 +1,142 @@
+"""Command line: `python3 -m pycal COMMAND ...` (wrapped by `./run.sh pycal ...`).
+
+Every user error prints one line `error: <file>: <field>: <reason>` and exits 2;
+a failed simulation exits 3.
+"""
+import argparse
+import json
+import sys
+
+from .errors import ConfigError, PycalError, RunError
+
+
+def _cmd_validate(args):
+    from .configs import load_material, load_rig, material_names, rig_names, load_boundaries
+    from . import labdata
+    load_boundaries()
+    for m in material_names():
+        load_material(m)
+    for r in rig_names():
+        load_rig(r)
+    labdata.load_all()
+    print(f"ok: {len(material_names())} materials, {len(rig_names())} rigs, lab data valid")
+
+
+def _make_jobs(args):
+    from .jobs import parse_set, resolve_job
+    overrides = parse_set(args.set)
+    seeds = list(range(args.seed, args.seed + args.seeds))
+    return [resolve_job(args.rig, args.material, overrides, seed=s) for s in seeds]
+
+
+def _cmd_run(args):
+    from .runner import make_executor
+    jobs = _make_jobs(args)
+    ex = make_executor(args.executor, runs_dir=args.out, workers=args.workers,
+                       timeout_s=args.timeout_s)
+    results = ex.run(jobs)
+    from . import post
+    for job, res in zip(jobs, results):
+        print(f"{job['job_id']}: {args.out}/{job['rig']}/{job['job_id']}")
+        print("  " + post.summary_line(res))
+    if len(results) > 1:
+        print(post.seed_statistics_text(results))
+
+
+def _cmd_batch_table(args):
+    from .runner import write_batch_table, _prepare
+    jobs = _make_jobs(args)
+    rows = []
+    for job in jobs:
+        tmp, final = _prepare(job, args.out)
+        rows.append((job["job_id"], tmp / "job.json"))
+    write_batch_table(args.table, rows)
+    print(f"wrote {args.table}: run with  yade-batch -j2 --job-threads 1 {args.table} "
+          f"yade_scripts/{jobs[0]['script']}")
+
+
+def _cmd_job(args):
+    jobs = _make_jobs(args)
+    print(json.dumps(jobs[0], indent=1, sort_keys=True))
+
+
+def _cmd_analyse(args):
+    from .lab_analysis import cli_analyse
+    cli_analyse(args)
+
+
+def _cmd_impact(args):
+    from .lab_analysis import cli_impact
+    cli_impact(args)
+
+
+def build_parser():
+    from .runner import DEFAULT_RUNS_DIR
+    p = argparse.ArgumentParser(prog="pycal", description="DEM calibration toolkit (YADE)")
+    sub = p.add_subparsers(dest="command", required=True)
+
+    s = sub.add_parser("validate", help="validate every config and lab-data file")
+    s.set_defaults(func=_cmd_validate)
+
+    def job_args(s):
+        s.add_argument("rig", help="rig name (configs/rigs/<rig>.yaml)")
+        s.add_argument("--material", required=True, help="material name (configs/materials/<name>.yaml)")
+        s.add_argument("--set", action="append", metavar="KEY=VALUE",
+                       help="override a material key (e.g. particles.density_kg_m3=3100) or a rig key "
+                            "(rig.procedure.lift_speed_m_s=0.01); repeatable")
+        s.add_argument("--seed", type=int, default=1, help="random seed of the fill (default 1)")
+        s.add_argument("--seeds", type=int, default=1, help="run this many seeds: seed, seed+1, ...")
+        s.add_argument("--out", default=str(DEFAULT_RUNS_DIR), help="runs directory (default runs/)")
+
+    s = sub.add_parser("run", help="run one rig job (or several seeds) in YADE")
+    job_args(s)
+    s.add_argument("--workers", type=int, default=None, help="parallel YADE processes (default: cores)")
+    s.add_argument("--executor", default="local", choices=["local", "yade-batch"])
+    s.add_argument("--timeout-s", type=float, default=3600.0, help="timeout per job in seconds")
+    s.set_defaults(func=_cmd_run)
+
+    s = sub.add_parser("job", help="print the resolved job file (no run)")
+    job_args(s)
+    s.set_defaults(func=_cmd_job)
+
+    s = sub.add_parser("batch-table", help="write the jobs as a yade-batch table")
+    job_args(s)
+    s.add_argument("--table", required=True, help="table file to write")
+    s.set_defaults(func=_cmd_batch_table)
+
+    s = sub.add_parser("analyse", help="lab analysis: moisture, densities, belt load, rolling "
+                                       "resistance estimate, impact stress vs drop height")
+    s.add_argument("--out", default="runs/lab_analysis", help="output folder for CSV and PNG")
+    s.set_defaults(func=_cmd_analyse)
+
+    s = sub.add_parser("impact", help="impact stress of a chute's stream at the receiving point")
+    s.add_argument("--drop-height-m", type=float, required=True)
+    s.add_argument("--belt-speed-m-s", type=float, required=True)
+    s.add_argument("--flow-t-h", type=float, required=True)
+    s.add_argument("--bulk-density-kg-m3", type=float, required=True)
+    s.set_defaults(func=_cmd_impact)
+
+    from . import extra_commands
+    extra_commands.register(sub)
+    return p
+
+
+def main(argv=None):
+    parser = build_parser()
+    args = parser.parse_args(argv)
+    try:
+        args.func(args)
+    except ConfigError as exc:
+        print(f"error: {exc}", file=sys.stderr)
+        return 2
+    except RunError as exc:
+        print(f"run failed: {exc}", file=sys.stderr)
+        return 3
+    except PycalError as exc:
+        print(f"error: {exc}", file=sys.stderr)
+        return 2
+    except KeyboardInterrupt:
+        print("interrupted: complete jobs are kept; run the same command again to resume",
+              file=sys.stderr)
+        return 130
+    return 0

@@ -1,0 +1,286 @@
+"""Load and validate configs/ (materials, boundaries, rigs, numerics).
+
+Every error names the file, the dotted key and the reason, e.g.
+``configs/materials/M2.yaml: particles.density_kg_m3: -5 must be > 0``.
+Unknown keys are errors, never silently ignored.
+"""
+import copy
+import re
+from pathlib import Path
+
+import yaml
+
+from . import CONFIG_DIR
+from .errors import ConfigError
+
+# Cohesion/adhesion models and their parameters (name -> (min, max) or None for no bound).
+COHESION_MODELS = {
+    "none": {},
+    # constant pull-off force = force_fraction x weight of the lighter particle,
+    # acting in contact and up to adhesive_distance_m beyond it
+    "force_fraction": {"force_fraction": (0.0, None), "adhesive_distance_m": (0.0, None)},
+}
+
+# Suffixes that say a rig/numerics key's unit (SI) or that it is dimensionless.
+UNIT_SUFFIXES = ("_m", "_m_s", "_m_s2", "_s", "_pa", "_n", "_kg", "_kg_m3", "_deg", "_deg_s",
+                 "_hz", "_j", "_rad", "_rad_s")
+DIMENSIONLESS_SUFFIXES = ("_ratio", "_fraction", "_factor", "_coefficient", "_count", "_percent")
+
+
+def _rel(path):
+    """Path as the user sees it (relative to the repo root when inside it)."""
+    path = Path(path).resolve()
+    try:
+        return str(path.relative_to(CONFIG_DIR.parent))
+    except ValueError:
+        return str(path)
+
+
+class YamlLoader(yaml.SafeLoader):
+    """SafeLoader that also reads 2.38e11 and 1e-3 as floats (YAML 1.1 wants 2.38e+11)."""
+
+
+YamlLoader.add_implicit_resolver(
+    "tag:yaml.org,2002:float",
+    re.compile(r"""^(?:[-+]?(?:[0-9][0-9_]*)\.[0-9_]*(?:[eE][-+]?[0-9]+)?
+                   |[-+]?[0-9][0-9_]*[eE][-+]?[0-9]+
+                   |\.[0-9_]+(?:[eE][-+]?[0-9]+)?
+                   |[-+]?\.(?:inf|Inf|INF)
+                   |\.(?:nan|NaN|NAN))$""", re.X),
+    list("-+0123456789."))
+
+
+def parse_yaml_text(text):
+    return yaml.load(text, Loader=YamlLoader)
+
+
+def load_yaml(path):
+    """Read a YAML mapping; a syntax error or a non-mapping names the file."""
+    path = Path(path)
+    if not path.is_file():
+        raise ConfigError(_rel(path), "", "file not found")
+    try:
+        data = parse_yaml_text(path.read_text())
+    except yaml.YAMLError as exc:
+        raise ConfigError(_rel(path), "", f"not valid YAML: {exc}".replace("\n", " ")) from None
+    if not isinstance(data, dict):
+        raise ConfigError(_rel(path), "", "must be a YAML mapping")
+    return data
+
+
+class _Checker:
+    """Small helper to check fields of one file with dotted-key messages."""
+
+    def __init__(self, file):
+        self.file = _rel(file)
+
+    def fail(self, key, reason):
+        raise ConfigError(self.file, key, reason)
+
+    def keys(self, data, key, required, optional=()):
+        if not isinstance(data, dict):
+            self.fail(key, "must be a mapping")
+        for k in required:
+            if k not in data:
+                self.fail(f"{key}.{k}" if key else k, "missing")
+        allowed = set(required) | set(optional)
+        for k in data:
+            if k not in allowed:
+                self.fail(f"{key}.{k}" if key else k,
+                          f"unknown key (allowed: {', '.join(sorted(allowed))})")
+
+    def number(self, value, key, lo=None, hi=None, lo_open=False):
+        if isinstance(value, bool) or not isinstance(value, (int, float)):
+            self.fail(key, f"{value!r} must be a number")
+        if lo is not None and (value <= lo if lo_open else value < lo):
+            self.fail(key, f"{value} must be {'>' if lo_open else '>='} {lo}")
+        if hi is not None and value > hi:
+            self.fail(key, f"{value} must be <= {hi}")
+        return float(value)
+
+    def string(self, value, key, choices=None):
+        if not isinstance(value, str) or not value:
+            self.fail(key, f"{value!r} must be a non-empty string")
+        if choices is not None and value not in choices:
+            self.fail(key, f"{value!r} must be one of {', '.join(choices)}")
+        return value
+
+
+def material_names(config_dir=CONFIG_DIR):
+    return sorted(p.stem for p in (Path(config_dir) / "materials").glob("*.yaml"))
+
+
+def load_boundaries(config_dir=CONFIG_DIR):
+    """Boundary surfaces (steel, PVC...) with density, Young's modulus, Poisson ratio."""
+    path = Path(config_dir) / "boundaries.yaml"
+    data = load_yaml(path)
+    c = _Checker(path)
+    for name, b in data.items():
+        c.keys(b, name, ["density_kg_m3", "youngs_modulus_pa", "poisson_ratio"],
+               ["description", "provenance"])
+        c.number(b["density_kg_m3"], f"{name}.density_kg_m3", 0, lo_open=True)
+        c.number(b["youngs_modulus_pa"], f"{name}.youngs_modulus_pa", 0, lo_open=True)
+        c.number(b["poisson_ratio"], f"{name}.poisson_ratio", -1, 0.5)
+    return data
+
+
+def validate_material(data, path, partners):
+    """Check one material mapping; `partners` = every valid interaction partner name."""
+    c = _Checker(path)
+    c.keys(data, "", ["name", "particles", "contact", "interactions"],
+           ["description", "lab_sample", "moisture_percent_dry_basis", "provenance"])
+    if data["name"] != Path(path).stem and Path(path).suffix == ".yaml":
+        c.fail("name", f"{data['name']!r} must equal the file name {Path(path).stem!r}")
+    if "moisture_percent_dry_basis" in data:
+        c.number(data["moisture_percent_dry_basis"], "moisture_percent_dry_basis", 0, 100)
+    p = data["particles"]
+    c.keys(p, "particles", ["shape", "density_kg_m3"], ["diameter_m", "size_classes", "shapes"])
+    shape = c.string(p["shape"], "particles.shape", ["sphere", "clump"])
+    c.number(p["density_kg_m3"], "particles.density_kg_m3", 0, lo_open=True)
+    if shape == "sphere":
+        if "diameter_m" not in p:
+            c.fail("particles.diameter_m", "missing (required for shape: sphere)")
+        c.number(p["diameter_m"], "particles.diameter_m", 0, lo_open=True)
+    else:
+        _validate_clump_particles(c, p)
+    k = data["contact"]
+    c.keys(k, "contact", ["youngs_modulus_pa", "poisson_ratio", "restitution"])
+    c.number(k["youngs_modulus_pa"], "contact.youngs_modulus_pa", 0, lo_open=True)
+    c.number(k["poisson_ratio"], "contact.poisson_ratio", -1, 0.5)
+    c.number(k["restitution"], "contact.restitution", 0.05, 1.0)
+    inter = data["interactions"]
+    if not isinstance(inter, dict):
+        c.fail("interactions", "must be a mapping partner -> properties")
+    for needed in [data["name"]] + [b for b in partners if b in load_boundaries_cached()]:
+        if needed not in inter:
+            c.fail(f"interactions.{needed}", "missing (every material needs itself and every boundary)")
+    for partner, props in inter.items():
+        key = f"interactions.{partner}"
+        if partner not in partners:
+            c.fail(key, f"unknown partner (materials and boundaries: {', '.join(sorted(partners))})")
+        c.keys(props, key, ["friction_coefficient", "rolling_resistance_coefficient", "cohesion"])
+        c.number(props["friction_coefficient"], f"{key}.friction_coefficient", 0)
+        c.number(props["rolling_resistance_coefficient"], f"{key}.rolling_resistance_coefficient", 0)
+        coh = props["cohesion"]
+        if not isinstance(coh, dict) or "model" not in coh:
+            c.fail(f"{key}.cohesion", "must be a mapping with a 'model' key")
+        model = c.string(coh["model"], f"{key}.cohesion.model", list(COHESION_MODELS))
+        params = COHESION_MODELS[model]
+        c.keys(coh, f"{key}.cohesion", ["model"] + list(params))
+        for name, (lo, hi) in params.items():
+            c.number(coh[name], f"{key}.cohesion.{name}", lo, hi)
+    return data
+
+
+def _validate_clump_particles(c, p):
+    for k in ("size_classes", "shapes"):
+        if k not in p:
+            c.fail(f"particles.{k}", "missing (required for shape: clump)")
+    shapes = p["shapes"]
+    if not isinstance(shapes, dict) or not shapes:
+        c.fail("particles.shapes", "must be a non-empty mapping")
+    for name, s in shapes.items():
+        c.keys(s, f"particles.shapes.{name}", ["vertical_aspect_ratio", "horizontal_aspect_ratio"],
+               ["smoothness", "corners_count", "superquadric_degree"])
+        for r in ("vertical_aspect_ratio", "horizontal_aspect_ratio"):
+            c.number(s[r], f"particles.shapes.{name}.{r}", 0, lo_open=True)
+    total = 0.0
+    for i, sc in enumerate(p["size_classes"]):
+        key = f"particles.size_classes[{i}]"
+        c.keys(sc, key, ["name", "min_size_m", "max_size_m", "mass_percent", "shape_percent"])
+        lo = c.number(sc["min_size_m"], f"{key}.min_size_m", 0, lo_open=True)
+        hi = c.number(sc["max_size_m"], f"{key}.max_size_m", 0, lo_open=True)
+        if hi <= lo:
+            c.fail(f"{key}.max_size_m", f"{hi} must be > min_size_m {lo}")
+        total += c.number(sc["mass_percent"], f"{key}.mass_percent", 0, 100)
+        share = sc["shape_percent"]
+        for sname, v in share.items():
+            if sname not in shapes:
+                c.fail(f"{key}.shape_percent.{sname}", "unknown shape (see particles.shapes)")
+            c.number(v, f"{key}.shape_percent.{sname}", 0, 100)
+        if abs(sum(share.values()) - 100.0) > 0.01:
+            c.fail(f"{key}.shape_percent", f"shares add up to {sum(share.values())}, not 100")
+
+
+_BOUNDARIES = {}
+
+
+def load_boundaries_cached(config_dir=CONFIG_DIR):
+    key = str(config_dir)
+    if key not in _BOUNDARIES:
+        _BOUNDARIES[key] = load_boundaries(config_dir)
+    return _BOUNDARIES[key]
+
+
+def load_material(name, config_dir=CONFIG_DIR):
+    """One validated material config by name (file configs/materials/<name>.yaml)."""
+    names = material_names(config_dir)
+    path = Path(config_dir) / "materials" / f"{name}.yaml"
+    if name not in names:
+        raise ConfigError(_rel(path), "", f"unknown material {name!r} (known: {', '.join(names)})")
+    partners = set(names) | set(load_boundaries_cached(config_dir))
+    return validate_material(load_yaml(path), path, partners)
+
+
+def check_rig_keys(data, c, key=""):
+    """Every numeric leaf key of a rig/numerics config must carry an SI unit suffix
+    (e.g. _m, _pa, _s, _deg_s) or a dimensionless one (e.g. _ratio, _count)."""
+    if isinstance(data, dict):
+        for k, v in data.items():
+            sub = f"{key}.{k}" if key else str(k)
+            is_num = (isinstance(v, (int, float)) and not isinstance(v, bool)) or (
+                isinstance(v, list) and v and all(isinstance(x, (int, float)) for x in v))
+            if is_num:
+                if not str(k).endswith(UNIT_SUFFIXES + DIMENSIONLESS_SUFFIXES):
+                    c.fail(sub, "numeric key needs a unit suffix (SI: "
+                           + ", ".join(UNIT_SUFFIXES) + "; or dimensionless: "
+                           + ", ".join(DIMENSIONLESS_SUFFIXES) + ")")
+                values = v if isinstance(v, list) else [v]
+                if any(x != x for x in values):
+                    c.fail(sub, "NaN is not a value")
+                if str(k).endswith(("_pa",)) and isinstance(v, list):
+                    if any(x <= 0 for x in v):
+                        c.fail(sub, "stresses must be > 0")
+            elif isinstance(v, dict):
+                check_rig_keys(v, c, sub)
+
+
+def load_numerics(config_dir=CONFIG_DIR):
+    path = Path(config_dir) / "numerics.yaml"
+    data = load_yaml(path)
+    check_rig_keys(data, _Checker(path))
+    return data
+
+
+def rig_names(config_dir=CONFIG_DIR):
+    return sorted(p.stem for p in (Path(config_dir) / "rigs").glob("*.yaml"))
+
+
+def load_rig(name, config_dir=CONFIG_DIR):
+    """One validated rig config by name, with the shared numerics merged in."""
+    names = rig_names(config_dir)
+    path = Path(config_dir) / "rigs" / f"{name}.yaml"
+    if name not in names:
+        raise ConfigError(_rel(path), "", f"unknown rig {name!r} (known: {', '.join(names)})")
+    data = load_yaml(path)
+    c = _Checker(path)
+    c.keys(data, "", ["name", "script", "geometry", "procedure"],
+           ["description", "measure", "assumptions", "numerics"])
+    if data["name"] != name:
+        c.fail("name", f"{data['name']!r} must equal the file name {name!r}")
+    c.string(data["script"], "script")
+    for section in ("geometry", "procedure", "measure", "numerics"):
+        if section in data and not isinstance(data[section], dict):
+            c.fail(section, "must be a mapping")
+    check_rig_keys(data, c)
+    boundaries = load_boundaries_cached(config_dir)
+    for k, v in data["geometry"].items():
+        if k.endswith("_material") and v not in boundaries:
+            c.fail(f"geometry.{k}", f"unknown boundary {v!r} (known: {', '.join(boundaries)})")
+    numerics = load_numerics(config_dir)
+    for k in data.get("numerics", {}):
+        if k not in numerics:
+            c.fail(f"numerics.{k}", f"unknown key (allowed: {', '.join(numerics)})")
+    merged = copy.deepcopy(data)
+    merged["numerics"] = {**numerics, **data.get("numerics", {})}
+    return merged
