@@ -1,0 +1,189 @@
+"""Scene building shared by every rig (runs inside YADE).
+
+Engines, time step, rig geometry (cell, table), loose random fill, rest criterion and
+blow-up guards. Every number comes from the job; nothing is defaulted here.
+"""
+import math
+import random
+
+from yade import O, utils, geom, pack
+from yade.wrapper import (ForceResetter, InsertionSortCollider, Bo1_Sphere_Aabb, Bo1_Facet_Aabb,
+                          InteractionLoop, Ig2_Sphere_Sphere_ScGeom6D, Ig2_Facet_Sphere_ScGeom6D,
+                          NewtonIntegrator, Sphere)
+from yade import Vector3
+
+from .contact import ContactModel
+from .jobio import RigFailure
+
+
+class Scene:
+    """One rig scene: materials, engines, bodies, checks.
+
+    numerics: the job's `rig_config.numerics` (time step factor, rest thresholds, guards).
+    """
+
+    def __init__(self, job):
+        self.job = job
+        self.rig = job["rig_config"]
+        self.num = self.rig["numerics"]
+        self.g = self.num["gravity_m_s2"]
+        self.material = job["material"]
+        O.reset()
+        random.seed(job["seed"])
+        self.contact = ContactModel(job, gravity=self.g)
+        self.radius = self.contact.radius(self.material)
+        self.newton = NewtonIntegrator(gravity=(0, 0, -self.g), damping=self.contact.damping(),
+                                       dampGravity=True, label="newton")
+        O.engines = [
+            ForceResetter(),
+            InsertionSortCollider([Bo1_Sphere_Aabb(), Bo1_Facet_Aabb()]),
+            InteractionLoop([Ig2_Sphere_Sphere_ScGeom6D(), Ig2_Facet_Sphere_ScGeom6D()],
+                            [self.contact.ip2()], [self.contact.law2()]),
+            self.newton,
+        ]
+        self.sphere_ids = []
+        self.box_min = Vector3(-1, -1, -1)   # rig's bounding box for the escape guard (set by geometry)
+        self.box_max = Vector3(1, 1, 1)
+        self.n_guard_checks = 0
+
+    # ---------- geometry ----------
+    def add_cylinder(self, diameter, height, segments, material, z0=0.0):
+        """Side wall of a cylinder (facets), axis z, bottom edge at z0. Returns facet ids."""
+        facets = geom.facetCylinder((0, 0, z0 + height / 2.0), diameter / 2.0, height,
+                                    segmentsNumber=segments, wallMask=4,
+                                    material=self.contact.mat_id[material])
+        return O.bodies.append(facets)
+
+    def add_table(self, half_width, material, z=0.0):
+        """Square horizontal plate (two facets) at height z. Returns facet ids."""
+        facets = geom.facetBox((0, 0, z), (half_width, half_width, 0), wallMask=1,
+                               material=self.contact.mat_id[material])
+        return O.bodies.append(facets)
+
+    def set_domain(self, lo, hi):
+        """Bounding box of the rig (m); particles beyond it plus the margin have escaped."""
+        m = self.num["domain_margin_m"]
+        self.box_min = Vector3(*lo) - Vector3(m, m, m)
+        self.box_max = Vector3(*hi) + Vector3(m, m, m)
+
+    # ---------- particles ----------
+    def pour_cloud(self, diameter, z_bottom, column_height, porosity):
+        """Loose non-overlapping random spheres in a vertical cylinder of the given
+        diameter (m) from z_bottom up (m), seeded by the job's seed. Returns their ids."""
+        r = self.radius
+        inner = diameter / 2.0 - r * 1.01
+        sp = pack.SpherePack()
+        lo = Vector3(-inner - r, -inner - r, z_bottom)
+        hi = Vector3(inner + r, inner + r, z_bottom + column_height)
+        volume_box = (hi - lo)[0] * (hi - lo)[1] * (hi - lo)[2]
+        n_max = int((1.0 - porosity) * volume_box / (4.0 / 3.0 * math.pi * r ** 3))
+        sp.makeCloud(lo, hi, rMean=r, rRelFuzz=0.0, num=max(n_max, 1), seed=self.job["seed"] + 1)
+        mat = self.contact.mat_id[self.material]
+        ids = []
+        for centre, rad in sp:
+            if math.hypot(centre[0], centre[1]) <= inner and centre[2] - rad >= z_bottom:
+                ids.append(O.bodies.append(utils.sphere(centre, rad, material=mat)))
+        if not ids:
+            raise RigFailure("pour: no particle fits in the pour column")
+        self.sphere_ids.extend(ids)
+        return ids
+
+    def remove_spheres(self, ids):
+        ids = set(ids)
+        for i in ids:
+            O.bodies.erase(i)
+        self.sphere_ids = [i for i in self.sphere_ids if i not in ids]
+
+    def live_spheres(self):
+        return [O.bodies[i] for i in self.sphere_ids if O.bodies[i] is not None]
+
+    # ---------- time step, rest, guards ----------
+    def set_timestep(self):
+        """dt = timestep_safety_factor x critical P-wave step of the particles (s)."""
+        dt = self.num["timestep_safety_factor"] * utils.PWaveTimeStep()
+        if not (0 < dt < 1e-2):
+            raise RigFailure(f"time step {dt} s is not plausible (are there particles?)")
+        O.dt = dt
+        return dt
+
+    def kinetic_energy_ratio(self):
+        """Kinetic energy of the particles / (their weight x one diameter) (-)."""
+        spheres = self.live_spheres()
+        if not spheres:
+            return 0.0
+        ke = sum(0.5 * b.state.mass * b.state.vel.squaredNorm()
+                 + 0.5 * sum(b.state.inertia[k] * b.state.angVel[k] ** 2 for k in range(3))
+                 for b in spheres)
+        ref = sum(b.state.mass for b in spheres) * self.g * 2.0 * self.radius
+        return ke / ref
+
+    def unbalanced_force_ratio(self):
+        """Mean |contact force + weight| of the particles / mean contact force (-).
+        (YADE's utils.unbalancedForce leaves out NewtonIntegrator's gravity.)"""
+        forces = [i.phys.normalForce.norm() for i in O.interactions if i.isReal]
+        mean_contact = sum(forces) / len(forces) if forces else 0.0
+        if mean_contact == 0.0:
+            return 0.0
+        grav = self.newton.gravity
+        spheres = self.live_spheres()
+        resid = sum((O.forces.f(b.id) + grav * b.state.mass).norm() for b in spheres) / len(spheres)
+        return resid / mean_contact
+
+    def is_at_rest(self):
+        if self.kinetic_energy_ratio() > self.num["rest_kinetic_energy_ratio"]:
+            return False
+        return self.unbalanced_force_ratio() < self.num["rest_unbalanced_force_ratio"]
+
+    def check(self):
+        """Blow-up guard: NaN, escape from the rig's box, overlap beyond the limit."""
+        self.n_guard_checks += 1
+        for b in self.live_spheres():
+            p = b.state.pos
+            if any(math.isnan(x) or math.isinf(x) for x in p):
+                raise RigFailure(f"blow-up: particle {b.id} has position {p} at t={O.time:.4f} s")
+            if any(p[k] < self.box_min[k] or p[k] > self.box_max[k] for k in range(3)):
+                raise RigFailure(f"blow-up: particle {b.id} left the rig domain at {tuple(round(x, 4) for x in p)} "
+                                 f"(t={O.time:.4f} s): it escaped or passed through a wall")
+        limit = self.num["max_overlap_fraction"] * self.radius
+        for i in O.interactions:
+            if i.isReal and i.geom.penetrationDepth > limit:
+                raise RigFailure(f"blow-up: overlap {i.geom.penetrationDepth:.3g} m between bodies {i.id1} and "
+                                 f"{i.id2} exceeds {self.num['max_overlap_fraction']} x radius at t={O.time:.4f} s "
+                                 "(particles pass through each other or a wall)")
+
+    def run_for(self, seconds, every=None):
+        """Advance simulated time by `seconds`, checking the guards every rest interval.
+        `every(t)` is called at each check if given."""
+        chunk = max(1, int(round(self.num["rest_check_interval_s"] / O.dt)))
+        steps = int(math.ceil(seconds / O.dt))
+        done = 0
+        while done < steps:
+            n = min(chunk, steps - done)
+            O.run(n, True)
+            done += n
+            self.check()
+            if every is not None:
+                every(O.time)
+
+    def settle(self, what="settle"):
+        """Run until at rest (kinetic energy and unbalanced force below the thresholds).
+        Returns the simulated time it took (s)."""
+        t0 = O.time
+        chunk = max(1, int(round(self.num["rest_check_interval_s"] / O.dt)))
+        while True:
+            O.run(chunk, True)
+            self.check()
+            if self.is_at_rest():
+                return O.time - t0
+            if O.time - t0 > self.num["max_settle_time_s"]:
+                raise RigFailure(f"{what}: no rest after {self.num['max_settle_time_s']} s of simulated time "
+                                 f"(kinetic energy ratio {self.kinetic_energy_ratio():.3g}, "
+                                 f"unbalanced force ratio {self.unbalanced_force_ratio():.3g})")
+
+    # ---------- measurements ----------
+    def particle_mass_total(self):
+        return sum(b.state.mass for b in self.live_spheres())
+
+    def particle_positions(self):
+        """[(x, y, z, r)] of the live particles (m)."""
+        return [(b.state.pos[0], b.state.pos[1], b.state.pos[2], b.shape.radius) for b in self.live_spheres()]
