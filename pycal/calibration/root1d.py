@@ -1,0 +1,110 @@
+"""Noise-aware 1-D root finding for a response that is monotone in one parameter.
+
+Used for rolling resistance from the angle of repose, cohesion from the wet angle,
+and any other single parameter whose response rises (or falls) with it.
+
+`evaluate(x)` returns (mean, std, n) of the response over n seeds. A point meets the
+target when |mean - target| <= max(tolerance, 2 x std / sqrt(n)): the calibration
+is never asked to be tighter than its own seed-to-seed noise.
+"""
+import math
+from dataclasses import dataclass, field
+
+
+@dataclass
+class Point:
+    x: float
+    mean: float
+    std: float
+    n: int
+
+    def misfit(self, target):
+        return self.mean - target
+
+
+@dataclass
+class Solution:
+    x: float
+    point: Point
+    met: bool
+    history: list = field(default_factory=list)
+    message: str = ""
+
+
+def effective_tolerance(point, tolerance):
+    """The tolerance, widened to 2 standard errors of the mean where the noise is larger."""
+    if point.n > 1:
+        return max(tolerance, 2.0 * point.std / math.sqrt(point.n))
+    return tolerance
+
+
+def solve_monotone(evaluate, target, x0, lo, hi, tolerance, max_evaluations=6, first_step=None):
+    """Find x in [lo, hi] with response(x) = target within tolerance.
+
+    Strategy: evaluate the start x0; step towards the target (direction from a second
+    point) until the target is bracketed or a bound is reached; then regula falsi
+    (Illinois variant) inside the bracket. Stops when a point meets the target, after
+    max_evaluations, or when the target lies outside what the bounds can reach (then
+    the closest bound is returned with met=False and a message saying so).
+    """
+    if not lo <= x0 <= hi:
+        raise ValueError(f"start {x0} outside bounds [{lo}, {hi}]")
+    history = []
+
+    def ev(x):
+        mean, std, n = evaluate(x)
+        p = Point(float(x), float(mean), float(std), int(n))
+        history.append(p)
+        return p
+
+    def done(p, msg=""):
+        return Solution(p.x, p, abs(p.misfit(target)) <= effective_tolerance(p, tolerance), history, msg)
+
+    p0 = ev(x0)
+    if abs(p0.misfit(target)) <= effective_tolerance(p0, tolerance):
+        return done(p0)
+    step = first_step if first_step is not None else 0.25 * (hi - lo)
+    # probe a second point to learn the slope's sign
+    x1 = min(hi, x0 + step) if x0 + step <= hi else max(lo, x0 - step)
+    p1 = ev(x1)
+    increasing = (p1.mean - p0.mean) * (p1.x - p0.x) >= 0
+    a, b = (p0, p1) if p0.x < p1.x else (p1, p0)
+    # expand until bracketed
+    while len(history) < max_evaluations and not _brackets(a, b, target):
+        if abs(b.misfit(target)) <= effective_tolerance(b, tolerance):
+            return done(b)
+        if abs(a.misfit(target)) <= effective_tolerance(a, tolerance):
+            return done(a)
+        need_higher = target > max(a.mean, b.mean)
+        go_up = need_higher == increasing
+        if go_up:
+            if b.x >= hi:
+                return done(b, f"target {target:.4g} is beyond what the upper bound {hi} reaches ({b.mean:.4g})")
+            nxt = ev(min(hi, b.x + 2.0 * (b.x - a.x)))
+            a, b = b, nxt
+        else:
+            if a.x <= lo:
+                return done(a, f"target {target:.4g} is beyond what the lower bound {lo} reaches ({a.mean:.4g})")
+            nxt = ev(max(lo, a.x - 2.0 * (b.x - a.x)))
+            a, b = nxt, a
+    # Illinois regula falsi inside [a, b]: a and b keep opposite misfit signs
+    fa, fb = a.misfit(target), b.misfit(target)
+    while len(history) < max_evaluations:
+        best = min((a, b), key=lambda p: abs(p.misfit(target)))
+        if abs(best.misfit(target)) <= effective_tolerance(best, tolerance):
+            return done(best)
+        x = 0.5 * (a.x + b.x) if fb == fa else b.x - fb * (b.x - a.x) / (fb - fa)
+        p = ev(min(max(x, min(a.x, b.x)), max(a.x, b.x)))
+        fp = p.misfit(target)
+        if fp * fb < 0:
+            a, fa = b, fb
+        else:
+            fa *= 0.5        # Illinois: halve the weight of the end that stayed
+        b, fb = p, fp
+    best = min(history, key=lambda p: abs(p.misfit(target)))
+    return done(best, "" if abs(best.misfit(target)) <= effective_tolerance(best, tolerance)
+                else f"not met after {len(history)} evaluations")
+
+
+def _brackets(a, b, target):
+    return (a.mean - target) * (b.mean - target) <= 0

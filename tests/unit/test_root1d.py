@@ -1,0 +1,55 @@
+"""Noise-aware monotone root finding."""
+import math
+import random
+
+import pytest
+
+from pycal.calibration.root1d import solve_monotone, effective_tolerance, Point
+
+
+def response(f, noise=0.0, n=3, seed=0):
+    rng = random.Random(seed)
+
+    def evaluate(x):
+        vals = [f(x) + rng.gauss(0, noise) for _ in range(n)]
+        m = sum(vals) / n
+        s = math.sqrt(sum((v - m) ** 2 for v in vals) / (n - 1)) if n > 1 else 0.0
+        return m, s, n
+    return evaluate
+
+
+def test_increasing_response_is_solved():
+    # angle of repose rising with rolling resistance: 20 + 40 * eta
+    sol = solve_monotone(response(lambda x: 20 + 40 * x), target=38.0, x0=0.35, lo=0.0, hi=1.0,
+                         tolerance=0.5)
+    assert sol.met and abs(sol.x - 0.45) < 0.0125 + 1e-9
+    assert len(sol.history) <= 6
+
+
+def test_decreasing_response_is_solved():
+    sol = solve_monotone(response(lambda x: 100 * math.exp(-3 * x)), target=30.0, x0=0.1, lo=0.0,
+                         hi=2.0, tolerance=0.3)
+    assert sol.met and abs(100 * math.exp(-3 * sol.x) - 30) <= 0.3
+
+
+def test_start_already_good():
+    sol = solve_monotone(response(lambda x: 2 * x), target=1.0, x0=0.5, lo=0, hi=1, tolerance=0.01)
+    assert sol.met and len(sol.history) == 1
+
+
+def test_unreachable_target_is_reported():
+    sol = solve_monotone(response(lambda x: 20 + 10 * x), target=60.0, x0=0.3, lo=0.0, hi=1.0,
+                         tolerance=0.5)
+    assert not sol.met and "beyond what the upper bound" in sol.message and sol.x == 1.0
+
+
+def test_noise_widens_tolerance_and_still_converges():
+    sol = solve_monotone(response(lambda x: 20 + 40 * x, noise=2.0, n=3, seed=4), target=38.0,
+                         x0=0.2, lo=0.0, hi=1.0, tolerance=0.1, max_evaluations=10)
+    assert sol.met
+    assert effective_tolerance(sol.point, 0.1) > 0.1
+
+
+def test_effective_tolerance():
+    assert effective_tolerance(Point(0, 1, 3.0, 9), 0.5) == pytest.approx(2.0)
+    assert effective_tolerance(Point(0, 1, 0.1, 9), 0.5) == 0.5

@@ -1,0 +1,125 @@
+"""Runner: caching, atomic completion, failures, yade-batch tables, CLI errors.
+
+A fake `yade` (a small script) stands in for YADE so this layer runs in seconds.
+"""
+import json
+import os
+import stat
+
+import pytest
+
+from pycal import runner
+from pycal.cli import main
+from pycal.errors import RunError
+from pycal.jobs import resolve_job
+
+FAKE_YADE = """#!/bin/sh
+# fake yade: args are -j1 -x -n SCRIPT JOB; behaviour chosen by $FAKE_MODE
+job="$5"
+echo "fake yade running $4 $job"
+echo run >> "$FAKE_COUNT"
+case "$FAKE_MODE" in
+  ok) echo '{"bulk_density_kg_m3": 1600.0, "n_particles": 100}' > result.json ;;
+  fail) echo "RIG FAILED: blow-up: particle 7 left the rig domain"; exit 3 ;;
+  partial) echo '{"bulk' > result.json.part; exit 4 ;;
+  sleep) sleep 5 ;;
+esac
+"""
+
+
+@pytest.fixture
+def fake_yade(tmp_path, monkeypatch):
+    exe = tmp_path / "fake-yade"
+    exe.write_text(FAKE_YADE)
+    exe.chmod(exe.stat().st_mode | stat.S_IEXEC)
+    monkeypatch.setattr(runner, "YADE", str(exe))
+    count = tmp_path / "count"
+    count.write_text("")
+    monkeypatch.setenv("FAKE_COUNT", str(count))
+    monkeypatch.setenv("FAKE_MODE", "ok")
+    return lambda: len(count.read_text().split())
+
+
+def test_run_once_then_cached(tmp_path, fake_yade):
+    job = resolve_job("fill", "M2", seed=1)
+    r1 = runner.run_job(job, tmp_path / "runs")
+    r2 = runner.run_job(job, tmp_path / "runs")
+    assert r1 == r2 and r1["bulk_density_kg_m3"] == 1600.0
+    assert fake_yade() == 1
+    d = tmp_path / "runs" / "fill" / job["job_id"]
+    assert json.loads((d / "job.json").read_text()) == job
+    assert "fake yade running" in (d / "yade.log").read_text()
+    assert not list((tmp_path / "runs" / "fill").glob(".*tmp*"))
+
+
+def test_failure_keeps_log_and_writes_no_result(tmp_path, fake_yade, monkeypatch):
+    monkeypatch.setenv("FAKE_MODE", "fail")
+    job = resolve_job("fill", "M2", seed=1)
+    with pytest.raises(RunError, match="blow-up: particle 7 left the rig domain"):
+        runner.run_job(job, tmp_path / "runs")
+    assert not (tmp_path / "runs" / "fill" / job["job_id"]).exists()
+    failed = tmp_path / "runs" / "fill" / (job["job_id"] + ".failed")
+    assert (failed / "yade.log").is_file() and not (failed / "result.json").exists()
+    monkeypatch.setenv("FAKE_MODE", "ok")          # a later attempt runs again and succeeds
+    assert runner.run_job(job, tmp_path / "runs")["n_particles"] == 100
+
+
+def test_half_written_result_is_not_a_result(tmp_path, fake_yade, monkeypatch):
+    monkeypatch.setenv("FAKE_MODE", "partial")
+    job = resolve_job("fill", "M2", seed=1)
+    with pytest.raises(RunError):
+        runner.run_job(job, tmp_path / "runs")
+    assert runner.cached_result(job, tmp_path / "runs") is None
+
+
+def test_timeout(tmp_path, fake_yade, monkeypatch):
+    monkeypatch.setenv("FAKE_MODE", "sleep")
+    job = resolve_job("fill", "M2", seed=1)
+    with pytest.raises(RunError, match="timeout"):
+        runner.run_job(job, tmp_path / "runs", timeout_s=0.5)
+
+
+def test_pool_runs_each_job_once(tmp_path, fake_yade):
+    jobs = [resolve_job("fill", "M2", seed=s) for s in (1, 2, 3)]
+    pool = runner.LocalPool(tmp_path / "runs", workers=2, progress=False)
+    assert len(pool.run(jobs)) == 3
+    assert len(pool.run(jobs + jobs)) == 6
+    assert fake_yade() == 3
+
+
+def test_pool_reports_failures(tmp_path, fake_yade, monkeypatch):
+    monkeypatch.setenv("FAKE_MODE", "fail")
+    pool = runner.LocalPool(tmp_path / "runs", workers=2, progress=False)
+    jobs = [resolve_job("fill", "M2", seed=s) for s in (1, 2)]
+    with pytest.raises(RunError, match="2 of 2 job"):
+        pool.run(jobs)
+    assert pool.run(jobs, raise_on_error=False) == [None, None]
+
+
+def test_batch_table(tmp_path):
+    table = tmp_path / "t.table"
+    runner.write_batch_table(table, [("a", tmp_path / "a.json"), ("b", tmp_path / "b.json")])
+    lines = table.read_text().splitlines()
+    assert lines[0] == "description jobFile" and lines[1].startswith("a /")
+
+
+def test_cli_bad_material_one_line_exit_2(tmp_path, capsys):
+    rc = main(["run", "fill", "--material", "M9", "--out", str(tmp_path / "runs")])
+    err = capsys.readouterr().err.strip()
+    assert rc == 2 and err.count("\n") == 0
+    assert err == "error: configs/materials/M9.yaml: unknown material 'M9' (known: M1, M2, M3-dry, M3-wet)"
+    assert not (tmp_path / "runs").exists()
+
+
+def test_cli_bad_override_exit_2(tmp_path, capsys):
+    rc = main(["run", "fill", "--material", "M2", "--set", "particles.density_kg_m3=-5",
+               "--out", str(tmp_path / "runs")])
+    assert rc == 2
+    assert "particles.density_kg_m3: -5 must be > 0" in capsys.readouterr().err
+    assert not (tmp_path / "runs").exists()
+
+
+def test_cli_run_with_fake_yade(tmp_path, fake_yade, capsys):
+    rc = main(["run", "fill", "--material", "M2", "--seeds", "2", "--out", str(tmp_path / "runs")])
+    out = capsys.readouterr().out
+    assert rc == 0 and "bulk_density_kg_m3=1600" in out and "over 2 seeds" in out
