@@ -1,13 +1,9 @@
-"""Commands added by later stages of the pipeline (calibration, reports, rig studies).
-
-Each stage adds a `register_<stage>(sub)` call here, so cli.py stays small.
-"""
+"""Commands of the later pipeline stages (calibration, study), kept out of cli.py."""
 
 
 def register(sub):
     """Add the stage commands to the argparse sub-parsers."""
-    try:
-        from .calibration.cli import register as register_calibration
-    except ImportError:
-        return
-    register_calibration(sub)
+    from .calibration.cli import register as register_fit_density
+    from .calibration.calibrate_cli import register as register_calibrate
+    register_fit_density(sub)
+    register_calibrate(sub)

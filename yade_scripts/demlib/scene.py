@@ -151,6 +151,14 @@ class Scene:
                                  f"{i.id2} exceeds {self.num['max_overlap_fraction']} x radius at t={O.time:.4f} s "
                                  "(particles pass through each other or a wall)")
 
+    @staticmethod
+    def advance(steps):
+        """Run `steps` time steps now. O.step() in a loop: O.run(n, True) costs a fixed
+        ~8-40 ms per call for its wait (measured 27 % of a 250-step chunk)."""
+        step = O.step
+        for _ in range(int(steps)):
+            step()
+
     def run_for(self, seconds, every=None):
         """Advance simulated time by `seconds`, checking the guards every rest interval.
         `every(t)` is called at each check if given."""
@@ -159,7 +167,7 @@ class Scene:
         done = 0
         while done < steps:
             n = min(chunk, steps - done)
-            O.run(n, True)
+            self.advance(n)
             done += n
             self.check()
             if every is not None:
@@ -171,7 +179,7 @@ class Scene:
         t0 = O.time
         chunk = max(1, int(round(self.num["rest_check_interval_s"] / O.dt)))
         while True:
-            O.run(chunk, True)
+            self.advance(chunk)
             self.check()
             if self.is_at_rest():
                 return O.time - t0

@@ -1,0 +1,223 @@
+"""A calibration study: stages per material in the method's order (configs/calibrations/).
+
+Each stage moves one parameter group (several config keys set to one value) until a
+rig response matches its lab target, or copies values from another material. The
+values found are carried into the next stage. All runs go through one executor
+(pycal.runner), so nothing is simulated twice and a killed study resumes where it
+stopped when started again.
+
+Outputs in <out>/<study name>/:
+  calibrated/<material>.yaml   the material config with the calibrated values (loads as a config)
+  stages.csv                   one row per stage: parameter, value, response, target, met
+  history.csv                  every evaluated point: stage, x, response mean/std/n
+  summary.json                 everything above plus provenance
+"""
+import copy
+import csv
+import json
+import math
+import os
+import time
+from pathlib import Path
+
+import yaml
+
+from .. import CONFIG_DIR
+from ..configs import load_material, load_yaml, _Checker
+from ..errors import ConfigError
+from ..jobs import resolve_job, _set_path
+from ..post import mean_std
+from .root1d import solve_monotone
+
+STAGE_KEYS = {
+    "density": (["stage", "rig", "tolerance_percent"], ["max_iterations_count"]),
+    "rolling_resistance": (["stage", "rig", "response", "target", "parameter"],
+                           ["tolerance_deg", "max_iterations_count"]),
+    "cohesion": (["stage", "rig", "response", "target", "parameter"],
+                 ["tolerance_deg", "max_iterations_count"]),
+    "inherit": (["stage", "from", "keys"], []),
+}
+
+
+def load_study(path):
+    """Validated study config (file, key and reason in every error)."""
+    path = Path(path)
+    data = load_yaml(path)
+    c = _Checker(path)
+    c.keys(data, "", ["name", "materials", "seeds_count"],
+           ["description", "max_runs_count", "design_case"])
+    c.number(data["seeds_count"], "seeds_count", 1)
+    if "max_runs_count" in data:
+        c.number(data["max_runs_count"], "max_runs_count", 1)
+    for mat, stages in data["materials"].items():
+        load_material(mat)
+        if not isinstance(stages, list):
+            c.fail(f"materials.{mat}", "must be a list of stages")
+        for i, st in enumerate(stages):
+            key = f"materials.{mat}[{i}]"
+            if not isinstance(st, dict) or st.get("stage") not in STAGE_KEYS:
+                c.fail(f"{key}.stage", f"must be one of {', '.join(STAGE_KEYS)}")
+            req, opt = STAGE_KEYS[st["stage"]]
+            c.keys(st, key, req, opt)
+            if "parameter" in st:
+                p = st["parameter"]
+                c.keys(p, f"{key}.parameter", ["keys", "start", "bounds"])
+                lo, hi = p["bounds"]
+                if not lo <= p["start"] <= hi:
+                    c.fail(f"{key}.parameter.start", f"{p['start']} outside bounds {p['bounds']}")
+    return data
+
+
+class Study:
+    """Runs a study config with an executor (runner.LocalPool or runner.YadeBatch)."""
+
+    def __init__(self, config_path, executor, out_dir, log=print):
+        self.config_path = Path(config_path)
+        self.cfg = load_study(config_path)
+        self.executor = executor
+        self.out = Path(out_dir) / self.cfg["name"]
+        self.log = log
+        self.seeds = list(range(1, int(self.cfg["seeds_count"]) + 1))
+        self.overrides = {m: {} for m in self.cfg["materials"]}
+        self.stage_rows, self.history = [], []
+        self.runs_requested = 0
+        self.t0 = time.time()
+
+    # ---------- evaluation ----------
+    def evaluate(self, rig, material, extra, response, stage_name):
+        """(mean, std, n) of `response` over the study's seeds with the current overrides + extra."""
+        overrides = {**self.overrides[material], **extra}
+        jobs = [resolve_job(rig, material, overrides, seed=s) for s in self.seeds]
+        self.runs_requested += len(jobs)
+        budget = self.cfg.get("max_runs_count")
+        if budget and self.runs_requested > budget:
+            raise ConfigError(str(self.config_path), "max_runs_count",
+                              f"run budget of {budget} spent; raise it to continue")
+        results = self.executor.run(jobs)
+        values = [r[response] for r in results]
+        m, s = mean_std(values)
+        self.history.append({"material": material, "stage": stage_name, "rig": rig,
+                             "parameters": dict(extra), "response": response,
+                             "mean": m, "std": s, "n": len(values)})
+        self.log(f"  {material} {stage_name}: {extra} -> {response} = {m:.4g} +/- {s:.2g} "
+                 f"(runs requested {self.runs_requested}, elapsed {time.time() - self.t0:.0f} s)")
+        return m, s, len(values)
+
+    # ---------- stages ----------
+    def stage_density(self, material, st):
+        """Particle density from the cell fill (pycal.calibration.density), with the
+        values calibrated so far held fixed."""
+        from .density import fit_density, DENSITY_KEY
+        fixed = {k: v for k, v in self.overrides[material].items() if k != DENSITY_KEY}
+        fit = fit_density(material, seeds=len(self.seeds), tolerance_percent=st["tolerance_percent"],
+                          max_iterations=st.get("max_iterations_count", 5), executor=self.executor,
+                          out_dir=self.out / "density" / material, first_seed=self.seeds[0],
+                          start_density=self.overrides[material].get(DENSITY_KEY),
+                          overrides=fixed, progress=lambda m: self.log("  " + m))
+        self.runs_requested += len(self.seeds) * fit.iterations
+        for h in fit.history:
+            self.history.append({"material": material, "stage": "density", "rig": st["rig"],
+                                 "parameters": {DENSITY_KEY: h.particle_density_kg_m3},
+                                 "response": "bulk_density_kg_m3", "mean": h.bulk_density_mean_kg_m3,
+                                 "std": h.bulk_density_std_kg_m3, "n": h.n_seeds})
+        self.overrides[material][DENSITY_KEY] = fit.particle_density_kg_m3
+        return {"parameter": DENSITY_KEY, "value": fit.particle_density_kg_m3,
+                "response": "bulk_density_kg_m3", "response_mean": fit.bulk_density_mean_kg_m3,
+                "response_std": fit.bulk_density_std_kg_m3, "target": fit.target_bulk_density_kg_m3,
+                "tolerance": fit.target_bulk_density_kg_m3 * st["tolerance_percent"] / 100.0,
+                "met": fit.tolerance_met, "message": fit.message, "evaluations": fit.iterations}
+
+    def stage_monotone(self, material, st):
+        p = st["parameter"]
+        target = lab_target(st["target"])
+        tol = st.get("tolerance_deg", 2.0)
+
+        def evaluate(x):
+            return self.evaluate(st["rig"], material, {k: x for k in p["keys"]}, st["response"], st["stage"])
+
+        sol = solve_monotone(evaluate, target, p["start"], p["bounds"][0], p["bounds"][1], tol,
+                             max_evaluations=st.get("max_iterations_count", 6))
+        for k in p["keys"]:
+            self.overrides[material][k] = sol.x
+        return {"parameter": "+".join(p["keys"]), "value": sol.x, "response": st["response"],
+                "response_mean": sol.point.mean, "response_std": sol.point.std, "target": target,
+                "tolerance": tol, "met": sol.met, "message": sol.message,
+                "evaluations": len(sol.history)}
+
+    def stage_inherit(self, material, st):
+        src = st["from"]
+        row = next((r for r in self.stage_rows
+                    if r["material"] == src["material"] and r["stage"] == src["stage"]), None)
+        if row is None:
+            raise ConfigError(str(self.config_path), f"materials.{material}.from",
+                              f"stage {src['stage']} of {src['material']} must run before")
+        for k in st["keys"]:
+            self.overrides[material][k] = row["value"]
+        return {"parameter": "+".join(st["keys"]), "value": row["value"], "response": "",
+                "response_mean": math.nan, "response_std": math.nan, "target": math.nan,
+                "tolerance": math.nan, "met": True, "message": f"from {src['material']} {src['stage']}",
+                "evaluations": 0}
+
+    def run(self):
+        stage_fn = {"density": self.stage_density, "rolling_resistance": self.stage_monotone,
+                    "cohesion": self.stage_monotone, "inherit": self.stage_inherit}
+        n_stages = sum(len(s) for s in self.cfg["materials"].values())
+        k = 0
+        for material, stages in self.cfg["materials"].items():
+            for st in stages:
+                k += 1
+                self.log(f"[stage {k}/{n_stages}] {material}: {st['stage']}"
+                         + (f" on rig {st['rig']}" if "rig" in st else ""))
+                row = stage_fn[st["stage"]](material, st)
+                row.update({"material": material, "stage": st["stage"]})
+                self.stage_rows.append(row)
+                self.log(f"  -> {row['parameter']} = {row['value']:.4g}: "
+                         + ("target met" if row["met"] else f"NOT met {row['message']}"))
+                self.write_outputs()
+        return self.stage_rows
+
+    # ---------- outputs ----------
+    def calibrated_material(self, material):
+        mat = copy.deepcopy(load_material(material))
+        for k, v in self.overrides[material].items():
+            _set_path(mat, k, v, f"calibrated {material}")
+        mat["provenance"] = f"calibrated by study {self.cfg['name']} ({self.config_path.name})"
+        return mat
+
+    def write_outputs(self):
+        self.out.mkdir(parents=True, exist_ok=True)
+        (self.out / "calibrated").mkdir(exist_ok=True)
+        for m in self.cfg["materials"]:
+            _atomic(self.out / "calibrated" / f"{m}.yaml",
+                    yaml.safe_dump(self.calibrated_material(m), sort_keys=False))
+        cols = ["material", "stage", "parameter", "value", "response", "response_mean",
+                "response_std", "target", "tolerance", "met", "evaluations", "message"]
+        _atomic_csv(self.out / "stages.csv", cols, [[r.get(c, "") for c in cols] for r in self.stage_rows])
+        hcols = ["material", "stage", "rig", "parameters", "response", "mean", "std", "n"]
+        _atomic_csv(self.out / "history.csv", hcols,
+                    [[json.dumps(h[c]) if c == "parameters" else h[c] for c in hcols] for h in self.history])
+        summary = {"study": self.cfg, "stages": self.stage_rows, "history": self.history,
+                   "overrides": self.overrides, "runs_requested": self.runs_requested,
+                   "elapsed_s": time.time() - self.t0}
+        _atomic(self.out / "summary.json", json.dumps(summary, indent=1, default=str))
+
+
+def lab_target(target):
+    """Mean lab angle of a sample (left/right) for target {sample, test}."""
+    from .. import labdata
+    return labdata.aor_target_deg(target["sample"], target["test"])
+
+
+def _atomic(path, text):
+    tmp = Path(str(path) + ".part")
+    tmp.write_text(text)
+    os.replace(tmp, path)
+
+
+def _atomic_csv(path, columns, rows):
+    tmp = Path(str(path) + ".part")
+    with open(tmp, "w", newline="") as f:
+        w = csv.writer(f)
+        w.writerow(columns)
+        w.writerows(rows)
+    os.replace(tmp, path)

@@ -1,0 +1,126 @@
+"""The calibration study engine on a fake executor with known response laws.
+
+Fake physics: bulk density = 0.35 x particle density; angle of repose =
+20 deg + 40 deg x rolling resistance + 8 deg x cohesion force fraction. The engine must
+find the values that reproduce the lab targets, carry them from stage to stage, write
+loadable calibrated configs and resume without new runs.
+"""
+import math
+
+import pytest
+import yaml
+
+from pycal import labdata
+from pycal.calibration.study import Study, load_study
+from pycal.configs import validate_material, material_names, load_boundaries
+from pycal.errors import ConfigError
+from pycal.report import write_report
+
+STUDY = """
+name: twin
+seeds_count: 2
+max_runs_count: 200
+materials:
+  M3-dry:
+    - {stage: density, rig: fill, tolerance_percent: 1.0}
+    - stage: rolling_resistance
+      rig: aor
+      response: aor_mean_deg
+      target: {sample: fines_dry, test: angle_of_repose}
+      tolerance_deg: 0.5
+      parameter:
+        keys: [interactions.M3-dry.rolling_resistance_coefficient,
+               interactions.steel.rolling_resistance_coefficient,
+               interactions.pvc.rolling_resistance_coefficient]
+        start: 0.35
+        bounds: [0.05, 1.5]
+  M3-wet:
+    - stage: inherit
+      from: {material: M3-dry, stage: rolling_resistance}
+      keys: [interactions.M3-wet.rolling_resistance_coefficient,
+             interactions.steel.rolling_resistance_coefficient,
+             interactions.pvc.rolling_resistance_coefficient]
+    - stage: cohesion
+      rig: aor
+      response: aor_mean_deg
+      target: {sample: fines_wet, test: angle_of_repose}
+      tolerance_deg: 0.5
+      parameter: {keys: [interactions.M3-wet.cohesion.force_fraction], start: 0.5, bounds: [0.0, 5.0]}
+"""
+
+
+class FakeExecutor:
+    def __init__(self):
+        self.simulated = set()
+
+    def run(self, jobs):
+        out = []
+        for job in jobs:
+            self.simulated.add(job["job_id"])
+            mat = job["materials"][job["material"]]
+            name = job["material"]
+            rho = mat["particles"]["density_kg_m3"]
+            eta = mat["interactions"][name]["rolling_resistance_coefficient"]
+            coh = mat["interactions"][name]["cohesion"]
+            f = coh.get("force_fraction", 0.0) if name == "M3-wet" else 0.0
+            noise = 0.1 * math.sin(job["seed"])
+            out.append({"bulk_density_kg_m3": 0.35 * rho * (1 + 0.001 * noise),
+                        "aor_mean_deg": 20 + 40 * eta + 8 * f + noise})
+        return out
+
+
+@pytest.fixture
+def study_file(tmp_path):
+    p = tmp_path / "twin.yaml"
+    p.write_text(STUDY)
+    return p
+
+
+def test_study_recovers_known_parameters(tmp_path, study_file):
+    ex = FakeExecutor()
+    study = Study(study_file, ex, tmp_path / "out", log=lambda m: None)
+    rows = study.run()
+    assert all(r["met"] for r in rows), rows
+    by = {(r["material"], r["stage"]): r for r in rows}
+    assert by[("M3-dry", "density")]["value"] == pytest.approx(1601 / 0.35, rel=0.01)
+    dry_target = labdata.aor_target_deg("fines_dry")
+    eta = by[("M3-dry", "rolling_resistance")]["value"]
+    assert 20 + 40 * eta == pytest.approx(dry_target, abs=0.5)
+    assert by[("M3-wet", "inherit")]["value"] == eta
+    f = by[("M3-wet", "cohesion")]["value"]
+    assert 20 + 40 * eta + 8 * f == pytest.approx(labdata.aor_target_deg("fines_wet"), abs=0.5)
+    # calibrated configs load as configs
+    partners = set(material_names()) | set(load_boundaries())
+    for m in ("M3-dry", "M3-wet"):
+        path = tmp_path / "out" / "twin" / "calibrated" / f"{m}.yaml"
+        cal = yaml.safe_load(path.read_text())
+        validate_material(cal, path.with_name(f"{m}.yaml"), partners)
+    cal = yaml.safe_load((tmp_path / "out" / "twin" / "calibrated" / "M3-wet.yaml").read_text())
+    assert cal["interactions"]["M3-wet"]["rolling_resistance_coefficient"] == eta
+    # report
+    html = write_report(tmp_path / "out" / "twin").read_text()
+    assert "4 of 4 stage targets met" in html and "data:image/png;base64" in html
+
+
+def test_rerun_simulates_nothing_new(tmp_path, study_file):
+    ex = FakeExecutor()
+    Study(study_file, ex, tmp_path / "out", log=lambda m: None).run()
+    first = set(ex.simulated)
+    ex2 = FakeExecutor()
+    Study(study_file, ex2, tmp_path / "out", log=lambda m: None).run()
+    assert ex2.simulated == first      # same jobs asked again: a caching executor runs none of them
+
+
+def test_bad_study_config_names_field(tmp_path, study_file):
+    study_file.write_text(STUDY.replace("start: 0.35", "start: 3.5"))
+    with pytest.raises(ConfigError, match=r"twin.yaml: materials.M3-dry\[1\].parameter.start: 3.5 outside"):
+        load_study(study_file)
+    study_file.write_text(STUDY.replace("stage: inherit", "stage: guess"))
+    with pytest.raises(ConfigError, match=r"materials.M3-wet\[0\].stage: must be one of"):
+        load_study(study_file)
+
+
+def test_shipped_study_config_is_valid():
+    from pycal.calibration.calibrate_cli import DEFAULT_STUDY
+    cfg = load_study(DEFAULT_STUDY)
+    assert set(cfg["materials"]) == {"M2", "M3-dry", "M3-wet"}
