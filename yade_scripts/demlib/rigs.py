@@ -27,3 +27,139 @@ def fill_cell(scene):
 def write_positions(scene, out_dir, name):
     rows = scene.particle_positions()
     return write_csv(out_dir, name, ["x_m", "y_m", "z_m", "radius_m"], rows)
+
+
+# ---------- cylinder lift, pile measurement, table vibration (rigs aor, surcharge) ----------
+
+def highest_top(scene):
+    """Highest particle top z + r (m)."""
+    return max(b.state.pos[2] + b.shape.radius for b in scene.live_spheres())
+
+
+def set_velocity(ids, vel):
+    """Kinematic motion: NewtonIntegrator moves a non-dynamic body by its state.vel."""
+    from yade import Vector3
+    v = Vector3(*vel)
+    for i in ids:
+        O.bodies[i].state.vel = v
+
+
+def remove_fallen(scene, below_z):
+    """Erase particles whose centre fell below below_z (m): they rolled off the table
+    and are no longer part of the pile. Returns how many were removed."""
+    gone = [b.id for b in scene.live_spheres() if b.state.pos[2] < below_z]
+    if gone:
+        scene.remove_spheres(gone)
+    return len(gone)
+
+
+def lift_cylinder(scene, cyl_ids, speed, clearance, bottom_z=0.0, table_z=0.0):
+    """Lift the cylinder facets at `speed` (m/s) in chunks of the rest-check interval
+    (particles that fell off the table erased, then the guards checked, each chunk) until the cylinder's bottom edge is `clearance` (m)
+    above the highest particle top; then stop the facets (velocity zeroed: kinematic
+    bodies keep their velocity) and erase them. Returns {'lift_time_s', 'lift_height_m',
+    'n_fallen'}."""
+    if speed <= 0:
+        from .jobio import RigFailure
+        raise RigFailure(f"lift speed {speed} m/s must be > 0")
+    ref = cyl_ids[0]
+    z_ref0 = O.bodies[ref].state.pos[2]
+    t0 = O.time
+    limit = (highest_top(scene) + clearance - bottom_z) / speed * 1.5 + 1.0
+    interval = scene.num["rest_check_interval_s"]
+    fallen = 0
+    set_velocity(cyl_ids, (0, 0, speed))
+    steps = max(1, int(round(interval / O.dt)))
+    while True:
+        O.run(steps, True)
+        fallen += remove_fallen(scene, table_z - 2.0 * scene.radius)
+        scene.check()
+        if not scene.live_spheres():
+            from .jobio import RigFailure
+            raise RigFailure("lift: every particle fell off the table")
+        lifted = O.bodies[ref].state.pos[2] - z_ref0
+        if bottom_z + lifted >= highest_top(scene) + clearance:
+            break
+        if O.time - t0 > limit:
+            from .jobio import RigFailure
+            raise RigFailure(f"lift: cylinder not clear of the pile after {O.time - t0:.2f} s")
+    set_velocity(cyl_ids, (0, 0, 0))
+    for i in cyl_ids:
+        O.bodies.erase(i)
+    return {"lift_time_s": O.time - t0, "lift_height_m": lifted, "n_fallen": fallen}
+
+
+def settle_pile(scene, what, table_z=0.0):
+    """Scene.settle's loop (same rest criterion, guards and time limit), but particles
+    that rolled off the table are erased at every check before the guards see them
+    (a frictionless sphere slides for ever: Cundall damping does not act on a zero net
+    force). Returns (settle time s, number erased)."""
+    from .jobio import RigFailure
+    t0 = O.time
+    chunk = max(1, int(round(scene.num["rest_check_interval_s"] / O.dt)))
+    fallen = 0
+    while True:
+        O.run(chunk, True)
+        fallen += remove_fallen(scene, table_z - 2.0 * scene.radius)
+        if not scene.live_spheres():
+            raise RigFailure(f"{what}: every particle fell off the table")
+        scene.check()
+        if scene.is_at_rest():
+            return O.time - t0, fallen
+        if O.time - t0 > scene.num["max_settle_time_s"]:
+            raise RigFailure(f"{what}: no rest after {scene.num['max_settle_time_s']} s of simulated time "
+                             f"(kinetic energy ratio {scene.kinetic_energy_ratio():.3g}, "
+                             f"unbalanced force ratio {scene.unbalanced_force_ratio():.3g})")
+
+
+def vibrate_table(scene, table_ids, frequency, amp_x, amp_z, duration, updates_per_period=20):
+    """Kinematic elliptical vibration of the table facets (no dynamics of the table):
+    displacement x = amp_x sin(w t), z = amp_z (1 - cos(w t)) (90 degree phase, starts
+    at rest position), w = 2 pi frequency, for `duration` s. Velocity is set
+    `updates_per_period` times per period so that each chunk ends exactly on the
+    prescribed position (no drift); guards are checked every rest-check interval.
+    The table is stopped and put back at its home position at the end.
+    Returns {'vibration_time_s', 'n_fallen'}."""
+    import math
+    from yade import Vector3
+    w = 2.0 * math.pi * frequency
+    home = {i: Vector3(O.bodies[i].state.pos) for i in table_ids}
+    n = max(1, int(round(1.0 / (frequency * updates_per_period) / O.dt)))
+    total = int(math.ceil(duration / O.dt))
+    check = max(1, int(round(scene.num["rest_check_interval_s"] / O.dt)))
+    t0, done, next_check, fallen = O.time, 0, check, 0
+    while done < total:
+        k = min(n, total - done)
+        t_end = (done + k) * O.dt
+        off = Vector3(amp_x * math.sin(w * t_end), 0.0, amp_z * (1.0 - math.cos(w * t_end)))
+        for i in table_ids:
+            s = O.bodies[i].state
+            s.vel = (home[i] + off - s.pos) / (k * O.dt)
+        O.run(k, True)
+        done += k
+        if done >= next_check:
+            fallen += remove_fallen(scene, -2.0 * scene.radius)
+            scene.check()
+            next_check += check
+    for i in table_ids:
+        O.bodies[i].state.vel = Vector3(0, 0, 0)
+        O.bodies[i].state.pos = home[i]
+    return {"vibration_time_s": O.time - t0, "n_fallen": fallen}
+
+
+def measure_pile(scene, out_dir, prefix="aor", files="pile", title=None):
+    """Measure the pile (pycal.post.aor; the rig script puts the repo root on sys.path),
+    write <files>_particles.csv, <files>_profile.csv and <files>_side.png.
+    Returns (result keys {prefix_left_deg, ...}, full measurement dict)."""
+    import os
+    from pycal.post import aor as aor_post
+    positions = scene.particle_positions()
+    write_csv(out_dir, f"{files}_particles.csv", ["x_m", "y_m", "z_m", "radius_m"], positions)
+    m = aor_post.measure_from_config(positions, scene.rig["measure"])
+    write_csv(out_dir, f"{files}_profile.csv", ["sector", "r_m", "z_top_m", "used_in_fit"],
+              aor_post.profile_rows(m))
+    try:
+        aor_post.plot_pile(positions, m, os.path.join(out_dir, f"{files}_side.png"), title=title)
+    except Exception as exc:  # a figure must not cost the run
+        print(f"warning: {files}_side.png not drawn: {exc}", flush=True)
+    return aor_post.result_keys(m, prefix), m

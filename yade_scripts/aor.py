@@ -1,0 +1,57 @@
+"""Rig 2: cylinder-lift angle of repose (method.md rig 2, lab-tests.md section 4).
+
+Fill the 145 x 95 mm PVC cylinder standing on the steel table (rigs.fill_cell: pour,
+settle, strike level), lift the cylinder kinematically at lift_speed_m_s until its
+bottom edge is lift_clearance_m above the highest particle top, remove it, settle the
+pile to rest and measure the four sector angles (pycal/post/aor.py documents the
+method). Particles that roll off the table are erased (n_fallen_off).
+Outputs: pile_particles.csv, pile_profile.csv, pile_side.png, result.json.
+Run: yade -j1 -x -n yade_scripts/aor.py job.json
+"""
+import os
+import sys
+
+_HERE = os.path.dirname(os.path.abspath(sys.argv[0]))  # yade -x: __file__ is not the script
+sys.path.insert(0, _HERE)
+sys.path.insert(0, os.path.dirname(_HERE))             # repo root: pycal.post.aor (no yade inside)
+from demlib.jobio import run_rig  # noqa: E402
+from demlib.scene import Scene  # noqa: E402
+from demlib import rigs  # noqa: E402
+
+
+def build_pile(scene):
+    """Fill, lift, settle. Returns the timing/count entries of result.json and the cell dict."""
+    from yade import O
+    p = scene.rig["procedure"]
+    cell = rigs.fill_cell(scene)
+    lift = rigs.lift_cylinder(scene, cell["cylinder_ids"], p["lift_speed_m_s"], p["lift_clearance_m"])
+    t_settle, n_fallen = rigs.settle_pile(scene, "pile settle")
+    return {
+        "lift_time_s": lift["lift_time_s"],
+        "lift_height_m": lift["lift_height_m"],
+        "settle_time_s": t_settle,
+        "fill_settle_time_s": cell["settle_time_s"],
+        "n_fallen_off": lift["n_fallen"] + n_fallen,
+        "steps": O.iter,
+        "timestep_s": cell["timestep_s"],
+    }, cell
+
+
+def pile_result(scene, out_dir, info, prefix="aor", files="pile", title="AoR"):
+    keys, m = rigs.measure_pile(scene, out_dir, prefix=prefix, files=files,
+                                title=f"{title} {scene.material} seed {scene.job['seed']}")
+    out = dict(keys)
+    out.update({"n_particles": m["n_particles"], "pile_height_m": m["pile_height_m"],
+                "pile_radius_m": m["pile_radius_m"]})
+    out.update(info)
+    return out
+
+
+def main(job, out_dir):
+    scene = Scene(job)
+    info, _ = build_pile(scene)
+    return pile_result(scene, out_dir, info)
+
+
+if __name__ == "__main__" and os.path.basename(sys.argv[0]) == "aor.py":
+    run_rig(main)

@@ -1,0 +1,43 @@
+"""Rig 3: surcharge angle after vibration (method.md rig 3, lab-tests.md section 5).
+
+Same as the AoR rig up to the settled pile and its angles (aor_* keys, pile_*.csv),
+then the table facets move kinematically on an ellipse (x = A_h sin wt,
+z = A_v (1 - cos wt), 90 degree phase) at vibration_frequency_hz for
+vibration_duration_s, stop at their home position, the pile settles and is measured
+again (surcharge_* keys, surcharge_*.csv, surcharge_side.png).
+Run: yade -j1 -x -n yade_scripts/surcharge.py job.json
+"""
+import os
+import sys
+
+_HERE = os.path.dirname(os.path.abspath(sys.argv[0]))  # yade -x: __file__ is not the script
+sys.path.insert(0, _HERE)
+sys.path.insert(0, os.path.dirname(_HERE))
+from demlib.jobio import run_rig  # noqa: E402
+from demlib.scene import Scene  # noqa: E402
+from demlib import rigs  # noqa: E402
+import aor  # noqa: E402  (its run_rig only runs when aor.py is the script)
+
+
+def main(job, out_dir):
+    from yade import O
+    scene = Scene(job)
+    p = scene.rig["procedure"]
+    info, cell = aor.build_pile(scene)
+    out = aor.pile_result(scene, out_dir, info)
+    vib = rigs.vibrate_table(scene, cell["table_ids"], p["vibration_frequency_hz"],
+                             p["vibration_amplitude_horizontal_m"], p["vibration_amplitude_vertical_m"],
+                             p["vibration_duration_s"])
+    t_settle, n_fallen = rigs.settle_pile(scene, "surcharge settle")
+    keys, m = rigs.measure_pile(scene, out_dir, prefix="surcharge", files="surcharge",
+                                title=f"surcharge {scene.material} seed {job['seed']}")
+    out.update(keys)
+    out.update({"surcharge_n_particles": m["n_particles"], "surcharge_pile_height_m": m["pile_height_m"],
+                "surcharge_pile_radius_m": m["pile_radius_m"], "vibration_time_s": vib["vibration_time_s"],
+                "surcharge_settle_time_s": t_settle,
+                "n_fallen_off": out["n_fallen_off"] + vib["n_fallen"] + n_fallen,
+                "steps": O.iter})
+    return out
+
+
+run_rig(main)
