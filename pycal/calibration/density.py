@@ -116,11 +116,12 @@ def update_density(rho_p, bulk_mean, target):
 
 def fit_density(material, seeds=3, tolerance_percent=1.0, max_iterations=5, executor=None,
                 out_dir=None, first_seed=1, start_density=None, overrides=None,
-                config_dir=CONFIG_DIR, progress=print):
+                config_dir=CONFIG_DIR, progress=print, target_bulk_density_kg_m3=None):
     """Calibrate the particle density of `material` on the cell fill. Returns DensityFit.
 
     executor: anything with run(jobs) -> list of result dicts (default LocalPool on runs/).
     overrides: other material/rig overrides kept fixed during the fit.
+    target_bulk_density_kg_m3: the bulk density to match (default: the lab sample's).
     """
     t0 = time.time()
     if executor is None:
@@ -131,7 +132,8 @@ def fit_density(material, seeds=3, tolerance_percent=1.0, max_iterations=5, exec
     if seeds < 1:
         raise ConfigError("--seeds", "", "must be >= 1")
     mat_cfg = load_material(material, config_dir)
-    target = lab_bulk_density(mat_cfg)
+    target = (float(target_bulk_density_kg_m3) if target_bulk_density_kg_m3 is not None
+              else lab_bulk_density(mat_cfg))
     tol = tolerance_percent / 100.0
     seed_list = list(range(first_seed, first_seed + seeds))
     rho = float(start_density if start_density is not None else mat_cfg["particles"]["density_kg_m3"])

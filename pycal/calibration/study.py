@@ -30,7 +30,7 @@ from ..post import mean_std
 from .root1d import solve_monotone
 
 STAGE_KEYS = {
-    "density": (["stage", "rig", "tolerance_percent"], ["max_iterations_count"]),
+    "density": (["stage", "rig", "tolerance_percent"], ["max_iterations_count", "target"]),
     "rolling_resistance": (["stage", "rig", "response", "target", "parameter"],
                            ["tolerance_deg", "max_iterations_count"]),
     "cohesion": (["stage", "rig", "response", "target", "parameter"],
@@ -59,6 +59,10 @@ def load_study(path):
                 c.fail(f"{key}.stage", f"must be one of {', '.join(STAGE_KEYS)}")
             req, opt = STAGE_KEYS[st["stage"]]
             c.keys(st, key, req, opt)
+            if "target" in st:
+                t = st["target"]
+                if not isinstance(t, dict) or not ("value" in t or {"sample", "test"} <= set(t)):
+                    c.fail(f"{key}.target", "must be {sample: KEY, test: NAME} or {value: NUMBER}")
             if "parameter" in st:
                 p = st["parameter"]
                 c.keys(p, f"{key}.parameter", ["keys", "start", "bounds"])
@@ -113,7 +117,8 @@ class Study:
                           max_iterations=st.get("max_iterations_count", 5), executor=self.executor,
                           out_dir=self.out / "density" / material, first_seed=self.seeds[0],
                           start_density=self.overrides[material].get(DENSITY_KEY),
-                          overrides=fixed, progress=lambda m: self.log("  " + m))
+                          overrides=fixed, progress=lambda m: self.log("  " + m),
+                          target_bulk_density_kg_m3=st.get("target", {}).get("value"))
         self.runs_requested += len(self.seeds) * fit.iterations
         for h in fit.history:
             self.history.append({"material": material, "stage": "density", "rig": st["rig"],
@@ -203,7 +208,10 @@ class Study:
 
 
 def lab_target(target):
-    """Mean lab angle of a sample (left/right) for target {sample, test}."""
+    """The target of a stage: {value: X} as given (e.g. a synthetic twin's hidden truth),
+    or the mean lab angle (left/right) of {sample, test}."""
+    if "value" in target:
+        return float(target["value"])
     from .. import labdata
     return labdata.aor_target_deg(target["sample"], target["test"])
 
