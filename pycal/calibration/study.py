@@ -32,9 +32,9 @@ from .root1d import solve_monotone
 STAGE_KEYS = {
     "density": (["stage", "rig", "tolerance_percent"], ["max_iterations_count", "target"]),
     "rolling_resistance": (["stage", "rig", "response", "target", "parameter"],
-                           ["tolerance_deg", "max_iterations_count"]),
+                           ["tolerance_deg", "max_iterations_count", "rig_overrides"]),
     "cohesion": (["stage", "rig", "response", "target", "parameter"],
-                 ["tolerance_deg", "max_iterations_count"]),
+                 ["tolerance_deg", "max_iterations_count", "rig_overrides"]),
     "inherit": (["stage", "from", "keys"], []),
 }
 
@@ -63,6 +63,9 @@ def load_study(path):
                 t = st["target"]
                 if not isinstance(t, dict) or not ("value" in t or {"sample", "test"} <= set(t)):
                     c.fail(f"{key}.target", "must be {sample: KEY, test: NAME} or {value: NUMBER}")
+            for k in st.get("rig_overrides", {}):
+                if not str(k).startswith("rig."):
+                    c.fail(f"{key}.rig_overrides.{k}", "only rig keys (rig.procedure...) may be overridden here")
             if "parameter" in st:
                 p = st["parameter"]
                 c.keys(p, f"{key}.parameter", ["keys", "start", "bounds"])
@@ -137,8 +140,11 @@ class Study:
         target = lab_target(st["target"])
         tol = st.get("tolerance_deg", 2.0)
 
+        fixed = dict(st.get("rig_overrides", {}))   # e.g. a measured-equivalent faster lift
+
         def evaluate(x):
-            return self.evaluate(st["rig"], material, {k: x for k in p["keys"]}, st["response"], st["stage"])
+            return self.evaluate(st["rig"], material, {**fixed, **{k: x for k in p["keys"]}},
+                                 st["response"], st["stage"])
 
         sol = solve_monotone(evaluate, target, p["start"], p["bounds"][0], p["bounds"][1], tol,
                              max_evaluations=st.get("max_iterations_count", 6))
