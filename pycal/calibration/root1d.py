@@ -38,7 +38,8 @@ def effective_tolerance(point, tolerance):
     return tolerance
 
 
-def solve_monotone(evaluate, target, x0, lo, hi, tolerance, max_evaluations=6, first_step=None):
+def solve_monotone(evaluate, target, x0, lo, hi, tolerance, max_evaluations=6, first_step=None,
+                   increasing=None):
     """Find x in [lo, hi] with response(x) = target within tolerance.
 
     Strategy: evaluate the start x0; step towards the target (direction from a second
@@ -46,6 +47,8 @@ def solve_monotone(evaluate, target, x0, lo, hi, tolerance, max_evaluations=6, f
     (Illinois variant) inside the bracket. Stops when a point meets the target, after
     max_evaluations, or when the target lies outside what the bounds can reach (then
     the closest bound is returned with met=False and a message saying so).
+    increasing: the response's direction when physics knows it (True/False); None =
+    learn it from the first two points (unsafe when the noise is larger than the change).
     """
     if not lo <= x0 <= hi:
         raise ValueError(f"start {x0} outside bounds [{lo}, {hi}]")
@@ -64,10 +67,19 @@ def solve_monotone(evaluate, target, x0, lo, hi, tolerance, max_evaluations=6, f
     if abs(p0.misfit(target)) <= effective_tolerance(p0, tolerance):
         return done(p0)
     step = first_step if first_step is not None else 0.25 * (hi - lo)
-    # probe a second point to learn the slope's sign
-    x1 = min(hi, x0 + step) if x0 + step <= hi else max(lo, x0 - step)
+    if increasing is None:
+        # probe a second point to learn the slope's sign
+        x1 = min(hi, x0 + step) if x0 + step <= hi else max(lo, x0 - step)
+    else:
+        # step towards the target
+        up = (target > p0.mean) == increasing
+        x1 = min(hi, x0 + step) if up else max(lo, x0 - step)
+        if x1 == x0:
+            return done(p0, f"target {target:.4g} is beyond what the {'upper' if up else 'lower'} "
+                            f"bound {x0} reaches ({p0.mean:.4g})")
     p1 = ev(x1)
-    increasing = (p1.mean - p0.mean) * (p1.x - p0.x) >= 0
+    if increasing is None:
+        increasing = (p1.mean - p0.mean) * (p1.x - p0.x) >= 0
     a, b = (p0, p1) if p0.x < p1.x else (p1, p0)
     # expand until bracketed
     while len(history) < max_evaluations and not _brackets(a, b, target):

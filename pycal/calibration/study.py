@@ -68,7 +68,7 @@ def load_study(path):
                     c.fail(f"{key}.rig_overrides.{k}", "only rig keys (rig.procedure...) may be overridden here")
             if "parameter" in st:
                 p = st["parameter"]
-                c.keys(p, f"{key}.parameter", ["keys", "start", "bounds"])
+                c.keys(p, f"{key}.parameter", ["keys", "start", "bounds"], ["response_increases"])
                 lo, hi = p["bounds"]
                 if not lo <= p["start"] <= hi:
                     c.fail(f"{key}.parameter.start", f"{p['start']} outside bounds {p['bounds']}")
@@ -147,7 +147,8 @@ class Study:
                                  st["response"], st["stage"])
 
         sol = solve_monotone(evaluate, target, p["start"], p["bounds"][0], p["bounds"][1], tol,
-                             max_evaluations=st.get("max_iterations_count", 6))
+                             max_evaluations=st.get("max_iterations_count", 6),
+                             increasing=p.get("response_increases"))
         for k in p["keys"]:
             self.overrides[material][k] = sol.x
         return {"parameter": "+".join(p["keys"]), "value": sol.x, "response": st["response"],

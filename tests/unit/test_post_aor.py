@@ -7,7 +7,7 @@ import pytest
 from pycal.post import aor
 
 R = 0.0125
-CFG = dict(bins_count=12, apex_fraction=0.15, toe_fraction=0.15, half_width_deg=45)
+CFG = dict(slice_height_m=0.0125, exclude_bottom_m=0.025, exclude_apex_m=0.0125, half_width_deg=45)
 
 
 def cone(angle_left, angle_right=None, height=0.1, spacing=0.004, layers=3):
@@ -58,17 +58,19 @@ def test_flat_layer_has_no_angle():
         assert a == pytest.approx(0.0, abs=0.5), side
 
 
-def test_rising_profile_and_too_few_bins_give_zero():
-    # a bowl (tops rise outwards): slope >= 0 -> 0 by rule
-    pts = [(x, 0.0, R + 0.5 * abs(x), R) for x in np.linspace(-0.1, 0.1, 41)]
+def test_vertical_column_is_90_degrees_and_one_particle_has_no_angle():
+    # a column of stacked rings (the wet pile that stands with vertical faces)
+    pts = [(0.05 * math.cos(t), 0.05 * math.sin(t), R + k * 2 * R, R)
+           for k in range(5) for t in np.linspace(0, 2 * math.pi, 24, endpoint=False)]
     m = aor.measure_pile(pts, **CFG)
-    assert m["angles"]["left"] == 0.0 and m["angles"]["right"] == 0.0
+    for side, a in m["angles"].items():
+        assert a == pytest.approx(90.0, abs=0.5), side
     # one particle: no fit at all
     m = aor.measure_pile([(0.0, 0.0, R, R)], **CFG)
     assert m["mean_deg"] == 0.0
 
 
-def test_apex_and_toe_bins_are_excluded():
+def test_first_layer_and_apex_are_excluded():
     m = aor.measure_pile(cone(35.0), **CFG)
     used = [p for p in m["fits"]["left"]["points"] if p[2]]
     assert 0 < len(used) < len(m["fits"]["left"]["points"])
@@ -84,3 +86,12 @@ def test_result_keys_and_plot(tmp_path):
                          "surcharge_back_deg", "surcharge_mean_deg"}
     png = aor.plot_pile(pts[:300], m, tmp_path / "p.png")
     assert (tmp_path / "p.png").stat().st_size > 1000 and png
+
+
+def test_particles_rolled_away_on_the_table_do_not_change_the_angle():
+    pile = cone(38.0)
+    strays = [(0.25, 0.01, R, R), (-0.22, 0.02, R, R), (0.03, 0.24, R, R), (0.0, -0.3, R, R)]
+    a = aor.measure_pile(pile, **CFG)["angles"]
+    b = aor.measure_pile(np.vstack([pile, strays]), **CFG)["angles"]
+    for side in a:
+        assert b[side] == pytest.approx(a[side], abs=1.0), side

@@ -53,3 +53,16 @@ def test_noise_widens_tolerance_and_still_converges():
 def test_effective_tolerance():
     assert effective_tolerance(Point(0, 1, 3.0, 9), 0.5) == pytest.approx(2.0)
     assert effective_tolerance(Point(0, 1, 0.1, 9), 0.5) == 0.5
+
+
+def test_known_direction_is_not_fooled_by_noise():
+    # a noisy first pair would suggest a falling response; physics says it rises
+    calls = iter([(23.7, 11.0, 3), (30.0, 5.0, 3), (42.1, 3.0, 3)])
+    seen = []
+
+    def evaluate(x):
+        seen.append(x)
+        return next(calls)
+    sol = solve_monotone(evaluate, target=42.0, x0=0.35, lo=0.02, hi=1.5, tolerance=2.0,
+                         increasing=True)
+    assert all(b > a for a, b in zip(seen, seen[1:])) and sol.met

@@ -156,7 +156,7 @@ def measure_pile(scene, out_dir, prefix="aor", files="pile", title=None):
     positions = scene.particle_positions()
     write_csv(out_dir, f"{files}_particles.csv", ["x_m", "y_m", "z_m", "radius_m"], positions)
     m = aor_post.measure_from_config(positions, scene.rig["measure"])
-    write_csv(out_dir, f"{files}_profile.csv", ["sector", "r_m", "z_top_m", "used_in_fit"],
+    write_csv(out_dir, f"{files}_profile.csv", ["sector", "r_edge_m", "z_m", "used_in_fit"],
               aor_post.profile_rows(m))
     try:
         aor_post.plot_pile(positions, m, os.path.join(out_dir, f"{files}_side.png"), title=title)
