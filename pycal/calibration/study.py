@@ -45,8 +45,10 @@ def load_study(path):
     data = load_yaml(path)
     c = _Checker(path)
     c.keys(data, "", ["name", "materials", "seeds_count"],
-           ["description", "max_runs_count", "design_case"])
+           ["description", "max_runs_count", "design_case", "max_seeds_count"])
     c.number(data["seeds_count"], "seeds_count", 1)
+    if "max_seeds_count" in data:
+        c.number(data["max_seeds_count"], "max_seeds_count", data["seeds_count"])
     if "max_runs_count" in data:
         c.number(data["max_runs_count"], "max_runs_count", 1)
     for mat, stages in data["materials"].items():
@@ -85,24 +87,37 @@ class Study:
         self.out = Path(out_dir) / self.cfg["name"]
         self.log = log
         self.seeds = list(range(1, int(self.cfg["seeds_count"]) + 1))
+        self.max_seeds = int(self.cfg.get("max_seeds_count", self.cfg["seeds_count"]))
         self.overrides = {m: {} for m in self.cfg["materials"]}
         self.stage_rows, self.history = [], []
         self.runs_requested = 0
         self.t0 = time.time()
 
     # ---------- evaluation ----------
-    def evaluate(self, rig, material, extra, response, stage_name):
-        """(mean, std, n) of `response` over the study's seeds with the current overrides + extra."""
-        overrides = {**self.overrides[material], **extra}
-        jobs = [resolve_job(rig, material, overrides, seed=s) for s in self.seeds]
+    def _run_seeds(self, rig, material, overrides, seeds):
+        jobs = [resolve_job(rig, material, overrides, seed=s) for s in seeds]
         self.runs_requested += len(jobs)
         budget = self.cfg.get("max_runs_count")
         if budget and self.runs_requested > budget:
             raise ConfigError(str(self.config_path), "max_runs_count",
                               f"run budget of {budget} spent; raise it to continue")
-        results = self.executor.run(jobs)
-        values = [r[response] for r in results]
+        return self.executor.run(jobs)
+
+    def evaluate(self, rig, material, extra, response, stage_name, tolerance=None):
+        """(mean, std, n) of `response` over the seeds with the current overrides + extra.
+
+        Noise-aware: while the standard error 2 std / sqrt(n) is larger than the
+        tolerance, more seeds are added (up to max_seeds_count), so that a point is not
+        judged "within tolerance" only because it is noisy."""
+        overrides = {**self.overrides[material], **extra}
+        values = [r[response] for r in self._run_seeds(rig, material, overrides, self.seeds)]
         m, s = mean_std(values)
+        n_next = len(values)
+        while tolerance is not None and n_next < self.max_seeds and 2 * s / math.sqrt(len(values)) > tolerance:
+            more = list(range(n_next + 1, min(self.max_seeds, 2 * n_next) + 1))
+            n_next = more[-1]
+            values += [r[response] for r in self._run_seeds(rig, material, overrides, more)]
+            m, s = mean_std(values)
         self.history.append({"material": material, "stage": stage_name, "rig": rig,
                              "parameters": dict(extra), "response": response,
                              "mean": m, "std": s, "n": len(values)})
@@ -144,7 +159,7 @@ class Study:
 
         def evaluate(x):
             return self.evaluate(st["rig"], material, {**fixed, **{k: x for k in p["keys"]}},
-                                 st["response"], st["stage"])
+                                 st["response"], st["stage"], tolerance=tol)
 
         sol = solve_monotone(evaluate, target, p["start"], p["bounds"][0], p["bounds"][1], tol,
                              max_evaluations=st.get("max_iterations_count", 6),

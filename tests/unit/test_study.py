@@ -124,3 +124,21 @@ def test_shipped_study_config_is_valid():
     from pycal.calibration.calibrate_cli import DEFAULT_STUDY
     cfg = load_study(DEFAULT_STUDY)
     assert set(cfg["materials"]) == {"M2", "M3-dry", "M3-wet"}
+
+
+def test_noisy_points_get_more_seeds(tmp_path):
+    cfg = tmp_path / "noisy.yaml"
+    cfg.write_text(STUDY.replace("seeds_count: 2", "seeds_count: 2\nmax_seeds_count: 8"))
+
+    class Noisy(FakeExecutor):
+        def run(self, jobs):
+            out = super().run(jobs)
+            for job, r in zip(jobs, out):   # +-10 deg seed noise on the angle
+                r["aor_mean_deg"] += 10.0 * (1 if job["seed"] % 2 else -1)
+            return out
+    ex = Noisy()
+    study = Study(cfg, ex, tmp_path / "out", log=lambda m: None)
+    m, s, n = study.evaluate("aor", "M3-dry", {}, "aor_mean_deg", "rolling_resistance", tolerance=2.0)
+    assert n == 8                                   # 2 -> 4 -> 8 seeds: the noise stays above tolerance
+    m, s, n = study.evaluate("aor", "M3-dry", {}, "aor_mean_deg", "rolling_resistance", tolerance=50.0)
+    assert n == 2                                   # quiet enough for a loose tolerance

@@ -71,7 +71,7 @@ def lift_cylinder(scene, cyl_ids, speed, clearance, bottom_z=0.0, table_z=0.0):
     set_velocity(cyl_ids, (0, 0, speed))
     steps = max(1, int(round(interval / O.dt)))
     while True:
-        O.run(steps, True)
+        scene.advance(steps)
         fallen += remove_fallen(scene, table_z - 2.0 * scene.radius)
         scene.check()
         if not scene.live_spheres():
@@ -99,7 +99,7 @@ def settle_pile(scene, what, table_z=0.0):
     chunk = max(1, int(round(scene.num["rest_check_interval_s"] / O.dt)))
     fallen = 0
     while True:
-        O.run(chunk, True)
+        scene.advance(chunk)
         fallen += remove_fallen(scene, table_z - 2.0 * scene.radius)
         if not scene.live_spheres():
             raise RigFailure(f"{what}: every particle fell off the table")
@@ -135,7 +135,7 @@ def vibrate_table(scene, table_ids, frequency, amp_x, amp_z, duration, updates_p
         for i in table_ids:
             s = O.bodies[i].state
             s.vel = (home[i] + off - s.pos) / (k * O.dt)
-        O.run(k, True)
+        scene.advance(k)
         done += k
         if done >= next_check:
             fallen += remove_fallen(scene, -2.0 * scene.radius)

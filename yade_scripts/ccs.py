@@ -1,0 +1,34 @@
+"""Rig 4a: confined compression (CCS) in the 145 x 95 mm cell (method.md rig 4).
+
+Fill the cell (pour, strike level, settle: demlib.rigs.fill_cell), put the steel plate
+procedure.plate_start_gap_m above the highest particle top, then for each of
+procedure.load_steps_pa servo the plate (demlib.loading) until the stress is within
+step_tolerance_ratio of the target and the bulk is at rest, and record the step.
+
+- stress = upward force of the particles on the plate / cell cross-section pi D^2 / 4;
+- h0 = the plate's first-contact height = the highest particle top before loading;
+  strain = (h0 - z_plate) / h0; bulk density = particle mass / (pi D^2 / 4 x z_plate)
+  (table at z = 0); solid fraction = bulk density / particle density;
+- bottom force = downward force of the particles on the table facets, wall force =
+  downward (friction) force on the cylinder facets; force balance error =
+  (plate + weight - bottom - wall) / (plate + weight);
+- stiffness = secant d stress / d strain between steps (first from zero).
+Outputs: result.json (per-step arrays), spring_curve.csv, lab_comparison.csv, PNGs.
+Run: yade -j1 -x -n yade_scripts/ccs.py job.json
+"""
+import os
+import sys
+
+sys.path.insert(0, os.path.dirname(os.path.abspath(sys.argv[0])))  # yade -x: __file__ is not the script
+from demlib.jobio import run_rig  # noqa: E402
+from demlib import compression  # noqa: E402
+
+
+def main(job, out_dir):
+    scene, cell, plate, rec, extra = compression.confined_setup(job)
+    for target in scene.rig["procedure"]["load_steps_pa"]:
+        rec.step(target, "loading")
+    return compression.finish(job, out_dir, scene, rec, extra)
+
+
+run_rig(main)

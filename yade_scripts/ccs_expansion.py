@@ -1,0 +1,34 @@
+"""Rig 4b: CCS expansion - load the confined cell high, then release it in steps
+(method.md rig 4, lab-tests.md section 8: the lab's particle-stiffness estimate).
+
+Same cell, plate, servo and per-step record as ccs.py (demlib.compression); the load
+steps procedure.load_steps_pa (branch 'loading') are followed by
+procedure.unload_steps_pa (branch 'unloading', decreasing). Each unloading step's
+stiffness is the secant d stress / d strain from the step before (the first from the
+last loading point): result.json `unloading_stiffness_pa` (and `unloading_stress_pa`,
+the stress each belongs to), besides the per-step arrays of every step.
+Run: yade -j1 -x -n yade_scripts/ccs_expansion.py job.json
+"""
+import os
+import sys
+
+sys.path.insert(0, os.path.dirname(os.path.abspath(sys.argv[0])))  # yade -x: __file__ is not the script
+from demlib.jobio import run_rig, RigFailure  # noqa: E402
+from demlib import compression  # noqa: E402
+
+
+def main(job, out_dir):
+    p = job["rig_config"]["procedure"]
+    load, unload = p["load_steps_pa"], p["unload_steps_pa"]
+    if any(b >= a for a, b in zip([load[-1]] + unload[:-1], unload)):
+        raise RigFailure(f"procedure.unload_steps_pa {unload}: must decrease, starting below the top load "
+                         f"{load[-1]} Pa")
+    scene, cell, plate, rec, extra = compression.confined_setup(job)
+    for target in load:
+        rec.step(target, "loading")
+    for target in unload:
+        rec.step(target, "unloading")
+    return compression.finish(job, out_dir, scene, rec, extra)
+
+
+run_rig(main)

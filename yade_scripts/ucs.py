@@ -1,0 +1,70 @@
+"""Rig 4c: unconfined compression (UCS) - a pile formed as in the AoR test, pressed by
+the steel plate, material free to move sideways (method.md rig 4).
+
+Fill the cylinder on the table (rigs.fill_cell), lift it at lift_speed_m_s until clear
+(rigs.lift_cylinder, cylinder erased), settle the pile (rigs.settle_pile), then a
+circular steel plate of geometry.plate_diameter_m (a 32-gon of the same area, demlib
+.loading.add_plate fit='equal_area') starts plate_start_gap_m above the pile top and is
+servoed through procedure.load_steps_pa (demlib.loading, same rule as CCS).
+
+- stress = upward force of the particles on the plate / plate area pi D^2 / 4;
+- h0 = the plate's first-contact height = the pile top; strain = (h0 - z_plate) / h0;
+- bulk density = mass of the particles whose centre lies within the plate's footprint
+  (radius D/2 around the axis) / (plate area x z_plate): the bulk under the plate;
+- bottom force = downward force on the table; wall force = 0 (no wall); force balance
+  (plate + weight - bottom) / (plate + weight) with the weight of each step (particles
+  that roll off the table are erased, as in the AoR rig).
+Outputs: result.json (per-step arrays), spring_curve.csv, lab_comparison.csv, PNGs.
+Run: yade -j1 -x -n yade_scripts/ucs.py job.json
+"""
+import math
+import os
+import sys
+
+sys.path.insert(0, os.path.dirname(os.path.abspath(sys.argv[0])))  # yade -x: __file__ is not the script
+from demlib.jobio import run_rig  # noqa: E402
+from demlib.scene import Scene  # noqa: E402
+from demlib import rigs, loading, compression  # noqa: E402
+
+PLATE_SEGMENTS = 32   # polygon of the circular plate (equal area: the stress area is exact)
+
+
+def main(job, out_dir):
+    scene = Scene(job)
+    g, p = scene.rig["geometry"], scene.rig["procedure"]
+    cell = rigs.fill_cell(scene)
+    lift = rigs.lift_cylinder(scene, cell["cylinder_ids"], p["lift_speed_m_s"], p["lift_clearance_m"])
+    t_settle, n_fallen = rigs.settle_pile(scene, "pile settle")
+    d = g["plate_diameter_m"]
+    area = math.pi * d * d / 4.0
+    h0 = compression.top_of_bulk(scene)
+    ids = loading.add_plate(scene, h0 + p["plate_start_gap_m"], d, g["plate_material"],
+                            segments=PLATE_SEGMENTS, fit="equal_area")
+    plate = loading.ServoPlate(scene, ids, area, p["plate_speed_max_m_s"], p["servo_relaxation_time_s"],
+                               p["servo_control_interval_s"], floor_z=0.0, footprint_radius_m=d / 2.0)
+    fallen = [n_fallen + lift["n_fallen"]]
+
+    def erase_fallen(t):
+        fallen[0] += rigs.remove_fallen(scene, -2.0 * scene.radius)
+
+    def mass_in_volume(z):
+        m = sum(b.state.mass for b in scene.live_spheres()
+                if math.hypot(b.state.pos[0], b.state.pos[1]) <= d / 2.0)
+        return m, area * z
+
+    rec = compression.StepRecorder(scene, plate, h0, cell["table_ids"], [], mass_in_volume,
+                                   p["step_tolerance_ratio"], every=erase_fallen)
+    pile_mass, pile_volume = mass_in_volume(h0)
+    for target in p["load_steps_pa"]:
+        rec.step(target, "loading")
+    extra = {"reference_area_m2": area, "fill_settle_time_s": cell["settle_time_s"],
+             "timestep_s": cell["timestep_s"], "lift_time_s": lift["lift_time_s"],
+             "pile_settle_time_s": t_settle, "pile_height_m": h0, "n_fallen_off": fallen[0],
+             "initial_bulk_density_kg_m3": pile_mass / pile_volume,
+             "strain_reference": "h0 = pile top before loading (plate first-contact height)",
+             "bulk_density_rule": "mass of particles with centre within the plate footprint / "
+                                  "(plate area x plate height)"}
+    return compression.finish(job, out_dir, scene, rec, extra)
+
+
+run_rig(main)
