@@ -29,6 +29,8 @@ BENCHES = {
     # name: (rig, material, overrides, seed)
     "fill": ("fill", "M2", {}, 1),          # M2 start values (density 2750, E 6e6)
     "aor": ("aor", "M2", {}, 1),            # needs yade_scripts/aor.py
+    # mixed -50 mm sample (M1 clumps + M2 + M3-dry), lift at 10 mm/s as in the measurements of issue 7
+    "aor_mixed": ("aor_mixed", "mixed-dry", {"rig.procedure.lift_speed_m_s": 0.01}, 1),
 }
 
 RESULTS = Path(__file__).resolve().parent / "results.jsonl"

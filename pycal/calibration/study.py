@@ -35,8 +35,21 @@ STAGE_KEYS = {
                            ["tolerance_deg", "max_iterations_count", "rig_overrides"]),
     "cohesion": (["stage", "rig", "response", "target", "parameter"],
                  ["tolerance_deg", "max_iterations_count", "rig_overrides"]),
+    "stiffness": (["stage", "rig", "response", "target", "parameter"],
+                  ["tolerance_log_ratio", "max_iterations_count"]),
     "inherit": (["stage", "from", "keys"], []),
 }
+
+
+def derived_responses():
+    """Responses computed from a whole result (name -> function(result) -> float)."""
+    from ..post.compression import unloading_stiffness_log_ratio
+    return {"unloading_stiffness_log_ratio": unloading_stiffness_log_ratio}
+
+
+def response_value(result, response):
+    derived = derived_responses()
+    return float(derived[response](result)) if response in derived else float(result[response])
 
 
 def load_study(path):
@@ -110,13 +123,13 @@ class Study:
         tolerance, more seeds are added (up to max_seeds_count), so that a point is not
         judged "within tolerance" only because it is noisy."""
         overrides = {**self.overrides[material], **extra}
-        values = [r[response] for r in self._run_seeds(rig, material, overrides, self.seeds)]
+        values = [response_value(r, response) for r in self._run_seeds(rig, material, overrides, self.seeds)]
         m, s = mean_std(values)
         n_next = len(values)
         while tolerance is not None and n_next < self.max_seeds and 2 * s / math.sqrt(len(values)) > tolerance:
             more = list(range(n_next + 1, min(self.max_seeds, 2 * n_next) + 1))
             n_next = more[-1]
-            values += [r[response] for r in self._run_seeds(rig, material, overrides, more)]
+            values += [response_value(r, response) for r in self._run_seeds(rig, material, overrides, more)]
             m, s = mean_std(values)
         self.history.append({"material": material, "stage": stage_name, "rig": rig,
                              "parameters": dict(extra), "response": response,
@@ -151,22 +164,30 @@ class Study:
                 "met": fit.tolerance_met, "message": fit.message, "evaluations": fit.iterations}
 
     def stage_monotone(self, material, st):
+        """One parameter group moved until a response that is monotone in it meets the
+        target. A stiffness spans decades: it is solved in log(E), values rounded to 3
+        significant digits (so that reruns hit the job cache)."""
         p = st["parameter"]
         target = lab_target(st["target"])
-        tol = st.get("tolerance_deg", 2.0)
-
+        tol = st["tolerance_log_ratio"] if "tolerance_log_ratio" in st else st.get("tolerance_deg", 2.0)
         fixed = dict(st.get("rig_overrides", {}))   # e.g. a measured-equivalent faster lift
+        log = st["stage"] == "stiffness"
+        to_x = (lambda u: float(f"{math.exp(u):.3g}")) if log else (lambda u: u)
+        to_u = math.log if log else (lambda x: x)
 
-        def evaluate(x):
+        def evaluate(u):
+            x = to_x(u)
             return self.evaluate(st["rig"], material, {**fixed, **{k: x for k in p["keys"]}},
                                  st["response"], st["stage"], tolerance=tol)
 
-        sol = solve_monotone(evaluate, target, p["start"], p["bounds"][0], p["bounds"][1], tol,
-                             max_evaluations=st.get("max_iterations_count", 6),
-                             increasing=p.get("response_increases"))
+        sol = solve_monotone(evaluate, target, to_u(p["start"]), to_u(p["bounds"][0]), to_u(p["bounds"][1]),
+                             tol, max_evaluations=st.get("max_iterations_count", 6),
+                             increasing=p.get("response_increases"),
+                             first_step=math.log(4.0) if log else None)
+        value = to_x(sol.x)
         for k in p["keys"]:
-            self.overrides[material][k] = sol.x
-        return {"parameter": "+".join(p["keys"]), "value": sol.x, "response": st["response"],
+            self.overrides[material][k] = value
+        return {"parameter": "+".join(p["keys"]), "value": value, "response": st["response"],
                 "response_mean": sol.point.mean, "response_std": sol.point.std, "target": target,
                 "tolerance": tol, "met": sol.met, "message": sol.message,
                 "evaluations": len(sol.history)}
@@ -187,7 +208,8 @@ class Study:
 
     def run(self):
         stage_fn = {"density": self.stage_density, "rolling_resistance": self.stage_monotone,
-                    "cohesion": self.stage_monotone, "inherit": self.stage_inherit}
+                    "cohesion": self.stage_monotone, "stiffness": self.stage_monotone,
+                    "inherit": self.stage_inherit}
         n_stages = sum(len(s) for s in self.cfg["materials"].values())
         k = 0
         for material, stages in self.cfg["materials"].items():

@@ -142,3 +142,29 @@ def test_noisy_points_get_more_seeds(tmp_path):
     assert n == 8                                   # 2 -> 4 -> 8 seeds: the noise stays above tolerance
     m, s, n = study.evaluate("aor", "M3-dry", {}, "aor_mean_deg", "rolling_resistance", tolerance=50.0)
     assert n == 2                                   # quiet enough for a loose tolerance
+
+
+def test_stiffness_stage_solves_in_log_space(tmp_path):
+    """Fake bulk unloading stiffness = 0.17 x E: log(sim / lab) = log(0.17 E / 6e6);
+    the stage must find E = 6e6 / 0.17 = 3.53e7 within +-28 % (tolerance 0.25 in log)."""
+    cfg = tmp_path / "stiff.yaml"
+    cfg.write_text("""
+name: stiff
+seeds_count: 2
+materials:
+  M2:
+    - stage: stiffness
+      rig: ccs_expansion
+      response: fake_log_ratio
+      target: {value: 0.0}
+      tolerance_log_ratio: 0.25
+      parameter: {keys: [contact.youngs_modulus_pa], start: 6.0e6, bounds: [1.0e6, 1.0e9], response_increases: true}
+""")
+
+    class Stiff(FakeExecutor):
+        def run(self, jobs):
+            return [{"fake_log_ratio": math.log(0.17 * j["materials"]["M2"]["contact"]["youngs_modulus_pa"] / 6e6)}
+                    for j in jobs]
+    (row,) = Study(cfg, Stiff(), tmp_path / "out", log=lambda m: None).run()
+    assert row["met"] and abs(math.log(row["value"] / 3.53e7)) <= 0.25
+    assert row["value"] == float(f"{row['value']:.3g}")
