@@ -18,8 +18,12 @@ def _cmd_validate(args):
         load_material(m)
     for r in rig_names():
         load_rig(r)
+    from .configs import load_material_set, material_set_names
+    for m in material_set_names():
+        load_material_set(m)
     labdata.load_all()
-    print(f"ok: {len(material_names())} materials, {len(rig_names())} rigs, lab data valid")
+    print(f"ok: {len(material_names())} materials, {len(material_set_names())} material sets, "
+          f"{len(rig_names())} rigs, lab data valid")
 
 
 def _make_jobs(args):
@@ -80,7 +84,8 @@ def build_parser():
 
     def job_args(s):
         s.add_argument("rig", help="rig name (configs/rigs/<rig>.yaml)")
-        s.add_argument("--material", required=True, help="material name (configs/materials/<name>.yaml)")
+        s.add_argument("--material", required=True, help="material name (configs/materials/<name>.yaml) or "
+                                                         "material set (configs/material_sets/<name>.yaml)")
         s.add_argument("--set", action="append", metavar="KEY=VALUE",
                        help="override a material key (e.g. particles.density_kg_m3=3100) or a rig key "
                             "(rig.procedure.lift_speed_m_s=0.01); repeatable")

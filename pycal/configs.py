@@ -265,10 +265,12 @@ def load_rig(name, config_dir=CONFIG_DIR):
     data = load_yaml(path)
     c = _Checker(path)
     c.keys(data, "", ["name", "script", "geometry", "procedure"],
-           ["description", "measure", "assumptions", "numerics"])
+           ["description", "measure", "assumptions", "numerics", "accepts_material_sets"])
     if data["name"] != name:
         c.fail("name", f"{data['name']!r} must equal the file name {name!r}")
     c.string(data["script"], "script")
+    if "accepts_material_sets" in data and not isinstance(data["accepts_material_sets"], bool):
+        c.fail("accepts_material_sets", f"{data['accepts_material_sets']!r} must be true or false")
     for section in ("geometry", "procedure", "measure", "numerics"):
         if section in data and not isinstance(data[section], dict):
             c.fail(section, "must be a mapping")
@@ -284,3 +286,136 @@ def load_rig(name, config_dir=CONFIG_DIR):
     merged = copy.deepcopy(data)
     merged["numerics"] = {**numerics, **data.get("numerics", {})}
     return merged
+
+
+# ---------------------------------------------------------------- material sets
+# configs/material_sets/<name>.yaml: several materials in one sample (e.g. the -50 mm
+# sample = M1 lumps + M2 gravel + M3 fines) with their mass shares and the properties
+# of every pair of two different components (cross_interactions). In a job of a set,
+# those pair values replace the components' own entries for each other on both sides,
+# so both materials of a pair agree (YADE needs one value per pair).
+
+SET_DIR = "material_sets"
+
+
+def material_set_names(config_dir=CONFIG_DIR):
+    return sorted(p.stem for p in (Path(config_dir) / SET_DIR).glob("*.yaml"))
+
+
+def _check_pair_props(c, props, key):
+    """friction, rolling resistance and cohesion of one pair (as under `interactions:`)."""
+    c.keys(props, key, ["friction_coefficient", "rolling_resistance_coefficient", "cohesion"])
+    c.number(props["friction_coefficient"], f"{key}.friction_coefficient", 0)
+    c.number(props["rolling_resistance_coefficient"], f"{key}.rolling_resistance_coefficient", 0)
+    coh = props["cohesion"]
+    if not isinstance(coh, dict) or "model" not in coh:
+        c.fail(f"{key}.cohesion", "must be a mapping with a 'model' key")
+    model = c.string(coh["model"], f"{key}.cohesion.model", list(COHESION_MODELS))
+    params = COHESION_MODELS[model]
+    c.keys(coh, f"{key}.cohesion", ["model"] + list(params))
+    for pname, (lo, hi) in params.items():
+        c.number(coh[pname], f"{key}.cohesion.{pname}", lo, hi)
+
+
+def _own_rolling(mat):
+    return float(mat["interactions"][mat["name"]]["rolling_resistance_coefficient"])
+
+
+def validate_material_set(data, path, materials):
+    """Check one material set mapping. `materials`: {name: validated material config} of
+    every known material. Returns the set with `mass_fraction` added to each component
+    (mass_percent / sum of the components' mass_percent)."""
+    c = _Checker(path)
+    c.keys(data, "", ["name", "components", "cross_interactions"],
+           ["description", "lab_sample", "provenance", "assumptions"])
+    if Path(path).suffix == ".yaml" and data["name"] != Path(path).stem:
+        c.fail("name", f"{data['name']!r} must equal the file name {Path(path).stem!r}")
+    if data["name"] in materials:
+        c.fail("name", f"{data['name']!r} is also a material name (configs/materials/)")
+    comps = data["components"]
+    if not isinstance(comps, dict) or len(comps) < 2:
+        c.fail("components", "must map at least two material names to their share")
+    total = 0.0
+    for name, comp in comps.items():
+        key = f"components.{name}"
+        if name not in materials:
+            c.fail(key, f"unknown material (known: {', '.join(sorted(materials))})")
+        mat = materials[name]
+        c.keys(comp, key, ["mass_percent"], ["size_classes"])
+        pct = c.number(comp["mass_percent"], f"{key}.mass_percent", 0, 100, lo_open=True)
+        total += pct
+        if "size_classes" in comp:
+            if mat["particles"]["shape"] != "clump":
+                c.fail(f"{key}.size_classes", f"only for clump materials ({name} is made of spheres)")
+            classes = {sc["name"]: sc for sc in mat["particles"]["size_classes"]}
+            chosen = comp["size_classes"]
+            if not isinstance(chosen, list) or not chosen:
+                c.fail(f"{key}.size_classes", "must be a non-empty list of size class names")
+            for cl in chosen:
+                if cl not in classes:
+                    c.fail(f"{key}.size_classes", f"unknown class {cl!r} of {name} (known: {', '.join(classes)})")
+            if len(set(chosen)) != len(chosen):
+                c.fail(f"{key}.size_classes", "a class is listed twice")
+            class_total = sum(classes[cl]["mass_percent"] for cl in chosen)
+            if abs(class_total - pct) > 0.01:
+                c.fail(f"{key}.mass_percent", f"{pct} differs from the sum of its size classes' "
+                                              f"mass_percent in configs/materials/{name}.yaml ({class_total:g})")
+    if total > 100.0 + 1e-9:
+        c.fail("components", f"mass_percent adds up to {total:g} > 100")
+    cross = data["cross_interactions"]
+    if not isinstance(cross, dict):
+        c.fail("cross_interactions", "must map each pair of different components once: A: {B: {...}}")
+    seen = set()
+    for a, partners in cross.items():
+        if a not in comps:
+            c.fail(f"cross_interactions.{a}", f"not a component ({', '.join(comps)})")
+        if not isinstance(partners, dict):
+            c.fail(f"cross_interactions.{a}", "must be a mapping partner -> properties")
+        for b, props in partners.items():
+            key = f"cross_interactions.{a}.{b}"
+            if b not in comps:
+                c.fail(key, f"not a component ({', '.join(comps)})")
+            if b == a:
+                c.fail(key, "a material with itself is set in its own config (configs/materials/)")
+            pair = frozenset((a, b))
+            if pair in seen:
+                c.fail(key, f"the pair {a} - {b} is listed twice")
+            seen.add(pair)
+            _check_pair_props(c, props, key)
+            # YADE's rolling law takes min(eta_a R_a, eta_b R_b): a pair can only have that value
+            ma, mb = materials[a], materials[b]
+            want = float(props["rolling_resistance_coefficient"])
+            if "clump" in (ma["particles"]["shape"], mb["particles"]["shape"]):
+                got = 0.0 if min(_own_rolling(m) for m in (ma, mb) if m["particles"]["shape"] == "clump") == 0 \
+                    else None
+                if got is None:
+                    c.fail(key, "clump materials take rolling resistance 0 (their member radii vary)")
+            else:
+                ra, rb = ma["particles"]["diameter_m"] / 2, mb["particles"]["diameter_m"] / 2
+                got = min(_own_rolling(ma) * ra, _own_rolling(mb) * rb) / min(ra, rb)
+            if abs(got - want) > 1e-9:
+                c.fail(f"{key}.rolling_resistance_coefficient",
+                       f"{want} cannot be realised: YADE uses min(eta_a R_a, eta_b R_b) of the two materials' "
+                       f"own coefficients, here {got:.4g}")
+    names = list(comps)
+    for i, a in enumerate(names):
+        for b in names[i + 1:]:
+            if frozenset((a, b)) not in seen:
+                c.fail(f"cross_interactions.{a}.{b}", "missing (every pair of two components, once)")
+    out = copy.deepcopy(data)
+    for name, comp in out["components"].items():
+        comp["mass_fraction"] = comp["mass_percent"] / total
+    return out
+
+
+def load_material_set(name, config_dir=CONFIG_DIR, materials=None):
+    """One validated material set by name (configs/material_sets/<name>.yaml), with
+    each component's mass_fraction. `materials` (optional): the component configs to
+    validate against (default: the shipped ones)."""
+    names = material_set_names(config_dir)
+    path = Path(config_dir) / SET_DIR / f"{name}.yaml"
+    if name not in names:
+        raise ConfigError(_rel(path), "", f"unknown material set {name!r} (known: {', '.join(names)})")
+    if materials is None:
+        materials = {m: load_material(m, config_dir) for m in material_names(config_dir)}
+    return validate_material_set(load_yaml(path), path, materials)

@@ -7,12 +7,14 @@ twice and an interrupted study resumes where it stopped.
 import copy
 import hashlib
 import json
+from pathlib import Path
 
 import yaml
 
 from . import CONFIG_DIR
 from .configs import (parse_yaml_text, load_boundaries_cached, load_material, load_rig, material_names,
                       validate_material, check_rig_keys, _Checker)
+from .configs import SET_DIR, load_yaml, material_set_names, rig_names, validate_material_set
 from .errors import ConfigError
 
 JOB_FORMAT = 1
@@ -54,6 +56,8 @@ def resolve_job(rig, material, overrides=None, seed=1, config_dir=CONFIG_DIR):
     """
     if isinstance(seed, bool) or not isinstance(seed, int) or seed < 0:
         raise ConfigError("--seed", "seed", f"{seed!r} must be a whole number >= 0")
+    if material in material_set_names(config_dir):
+        return resolve_set_job(rig, material, overrides, seed, config_dir)
     rig_cfg = load_rig(rig, config_dir)
     mat = copy.deepcopy(load_material(material, config_dir))
     overrides = dict(overrides or {})
@@ -72,6 +76,64 @@ def resolve_job(rig, material, overrides=None, seed=1, config_dir=CONFIG_DIR):
         "seed": seed,
         "material": material,
         "materials": {material: mat},
+        "boundaries": copy.deepcopy(load_boundaries_cached(config_dir)),
+        "rig_config": rig_cfg,
+        "overrides": overrides,
+    }
+    job["job_id"] = job_id(job)
+    return job
+
+
+def resolve_set_job(rig, set_name, overrides=None, seed=1, config_dir=CONFIG_DIR):
+    """Job of a material set (configs/material_sets/<set_name>.yaml) on a rig that
+    accepts sets (`accepts_material_sets: true` in its config).
+
+    job["material"] = the set's name; job["materials"] = every component material (in
+    the set's order) with the set's cross_interactions written into both materials of
+    each pair; job["material_set"] = the set (components with mass_percent,
+    mass_fraction and, for clump materials, the size classes used; cross_interactions).
+    overrides: 'rig.<key>' -> rig config, '<component>.<key>' -> that material
+    (e.g. 'M3-wet.interactions.M3-wet.cohesion.force_fraction'), any other key -> the
+    set (e.g. 'cross_interactions.M2.M3-wet.cohesion.force_fraction').
+    """
+    rig_cfg = load_rig(rig, config_dir)
+    if not rig_cfg.get("accepts_material_sets", False):
+        takers = [r for r in rig_names(config_dir) if load_rig(r, config_dir).get("accepts_material_sets", False)]
+        raise ConfigError(f"configs/rigs/{rig}.yaml", "accepts_material_sets",
+                          f"rig {rig} takes one material, and {set_name} is a material set "
+                          f"(rigs that take sets: {', '.join(takers) or 'none'})")
+    set_path = f"configs/{SET_DIR}/{set_name}.yaml"
+    raw = load_yaml(Path(config_dir) / SET_DIR / f"{set_name}.yaml")
+    known = {m: copy.deepcopy(load_material(m, config_dir)) for m in material_names(config_dir)}
+    comps = list(raw.get("components") or {}) if isinstance(raw.get("components"), dict) else []
+    overrides = dict(overrides or {})
+    for key, value in overrides.items():
+        head = key.split(".", 1)[0]
+        if key.startswith("rig."):
+            _set_path(rig_cfg, key[4:], value, f"overrides of configs/rigs/{rig}.yaml")
+        elif head in comps and "." in key:
+            _set_path(known[head], key.split(".", 1)[1], value, f"overrides of configs/materials/{head}.yaml")
+        else:
+            _set_path(raw, key, value, f"overrides of {set_path}")
+    partners = set(material_names(config_dir)) | set(load_boundaries_cached(config_dir))
+    for m in comps:
+        if m in known:
+            validate_material(known[m], f"configs/materials/{m}.yaml (with overrides)", partners)
+    mset = validate_material_set(raw, f"{set_path} (with overrides)" if overrides else set_path, known)
+    check_rig_keys(rig_cfg, _Checker(f"configs/rigs/{rig}.yaml (with overrides)"))
+    materials = {m: known[m] for m in mset["components"]}
+    for a, pairs in mset["cross_interactions"].items():
+        for b, props in pairs.items():
+            materials[a]["interactions"][b] = copy.deepcopy(props)
+            materials[b]["interactions"][a] = copy.deepcopy(props)
+    job = {
+        "job_format": JOB_FORMAT,
+        "rig": rig,
+        "script": rig_cfg["script"],
+        "seed": seed,
+        "material": set_name,
+        "materials": materials,
+        "material_set": mset,
         "boundaries": copy.deepcopy(load_boundaries_cached(config_dir)),
         "rig_config": rig_cfg,
         "overrides": overrides,

@@ -356,8 +356,10 @@ def _check_sample_rows(table, df, samples, lab_dir):
 
 
 def _check_material_refs(samples, config_dir, lab_dir):
-    """Every configs/materials/*.yaml `lab_sample:` must be a key of samples.yaml."""
-    for path in sorted((Path(config_dir) / "materials").glob("*.yaml")):
+    """Every configs/materials/*.yaml and configs/material_sets/*.yaml `lab_sample:` must be a
+    key of samples.yaml."""
+    for path in sorted((Path(config_dir) / "materials").glob("*.yaml")) + \
+            sorted((Path(config_dir) / "material_sets").glob("*.yaml")):
         ref = load_yaml(path).get("lab_sample")
         if ref is not None and ref not in samples:
             raise ConfigError(_rel(path, config_dir), "lab_sample",

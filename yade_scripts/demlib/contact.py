@@ -27,6 +27,9 @@ Mapping of config values (SI) to YADE:
 - cohesion `force_fraction` f per pair: a bond forms at each new contact with pull-off
   force and shear strength f x (weight of the lighter particle); it breaks once
   (fragile) and forms again at the next new contact.
+- clump materials (`shape: clump`, the M1 lumps of demlib.clumps): the member spheres
+  carry the material; rolling resistance must be 0 on every pair with them; cohesion
+  with a sphere partner acts as with a wall (force_fraction x the sphere's weight).
 """
 import math
 
@@ -67,6 +70,23 @@ class ContactModel:
         """Particle radius of a sphere material (m)."""
         return 0.5 * self.particles[name]["particles"]["diameter_m"]
 
+    def is_clump(self, name):
+        """True for a particle material made of clumps of spheres (M1 lumps, demlib.clumps)."""
+        return name in self.particles and self.particles[name]["particles"]["shape"] == "clump"
+
+    def wall_eta(self, bname):
+        """etaRoll of a boundary: the largest rolling coefficient any particle material asks
+        for on it, halved (facet radius 2R). With one particle material this is that
+        material's value; a material asking less must have its own etaRoll at its value."""
+        return max(self.pair(n, bname)["rolling_resistance_coefficient"] for n in self.particles) / WALL_RADIUS_FACTOR
+
+    def _bond_radius(self, a, b):
+        """Radius r of YADE's bond strength cohesion x r^2 for the pair a - b: the smaller
+        sphere radius of the pair (facets: 2R; clumps: see cohesion_force); 1 when
+        neither side is a sphere material (no cohesion allowed there)."""
+        radii = [self.radius(n) for n in (a, b) if n in self.particles and not self.is_clump(n)]
+        return min(radii) if radii else 1.0
+
     def particle_mass(self, name):
         r = self.radius(name)
         return self.particles[name]["particles"]["density_kg_m3"] * 4.0 / 3.0 * math.pi * r ** 3
@@ -83,7 +103,7 @@ class ContactModel:
         names = list(self.particles)
         for name in names:
             p = self.particles[name]
-            if p["particles"]["shape"] != "sphere":
+            if p["particles"]["shape"] not in ("sphere", "clump"):
                 raise RigFailure(f"material {name}: shape {p['particles']['shape']!r} is not supported by this rig")
             c = p["contact"]
             self_pair = self.pair(name, name)
@@ -96,8 +116,8 @@ class ContactModel:
                             label=name)
             self.mat_id[name] = O.materials.append(m)
         for bname, b in self.boundaries.items():
-            # rolling of a wall: the first particle material that touches it sets etaRoll
-            eta = self.pair(names[0], bname)["rolling_resistance_coefficient"] / WALL_RADIUS_FACTOR
+            # rolling of a wall: the largest value a particle material asks for (see wall_eta)
+            eta = self.wall_eta(bname)
             m = CohFrictMat(young=b["youngs_modulus_pa"], poisson=shear_ratio(b["poisson_ratio"]),
                             density=b["density_kg_m3"], frictionAngle=0.0, etaRoll=eta,
                             alphaKr=2.0, etaTwist=eta, alphaKtw=2.0, momentRotationLaw=True,
@@ -109,16 +129,34 @@ class ContactModel:
     def _check_rolling(self):
         """Every requested per-pair rolling coefficient must be what YADE will use."""
         names = list(self.particles)
+        # clump materials: member radii vary, so only rolling resistance 0 has one meaning
+        # (YADE's min(eta_a R_a, eta_b R_b) is 0 whatever the radii): the clump's own value
+        # and every pair value with it, asked from either side, must be 0
         for a in names:
+            if not self.is_clump(a):
+                continue
+            for b in names + list(self.boundaries):
+                for x, y in ((a, b), (b, a)):
+                    if x in self.particles and y in self.particles[x]["interactions"] and \
+                            self.particles[x]["interactions"][y]["rolling_resistance_coefficient"] != 0:
+                        raise RigFailure(
+                            f"materials.{x}.interactions.{y}.rolling_resistance_coefficient: "
+                            f"{self.particles[x]['interactions'][y]['rolling_resistance_coefficient']} cannot be "
+                            f"realised: {a} is made of clumps, which take rolling resistance 0 (the shape does it)")
+        for a in names:
+            if self.is_clump(a):
+                continue
             ra = self.radius(a)
             eta_a = self.pair(a, a)["rolling_resistance_coefficient"]
             for b in list(self.particles) + list(self.boundaries):
+                if self.is_clump(b):
+                    continue
                 want = self.pair(a, b)["rolling_resistance_coefficient"]
                 if b in self.particles:
                     rb, eta_b = self.radius(b), self.pair(b, b)["rolling_resistance_coefficient"]
                 else:
                     rb = WALL_RADIUS_FACTOR * ra
-                    eta_b = self.pair(names[0], b)["rolling_resistance_coefficient"] / WALL_RADIUS_FACTOR
+                    eta_b = self.wall_eta(b)
                 got = min(eta_a * ra, eta_b * rb) / min(ra, rb)
                 if abs(got - want) > 1e-9:
                     raise RigFailure(
@@ -138,7 +176,15 @@ class ContactModel:
             raise RigFailure(f"materials.{a}.interactions.{b}.cohesion.adhesive_distance_m: "
                              f"{coh['adhesive_distance_m']} > 0 is not supported by the fragile-bond law "
                              "(bonds act in contact only); set it to 0")
-        masses = [self.particle_mass(n) for n in (a, b) if n in self.particles]
+        # a clump partner acts like a wall: the pull-off is force_fraction x the weight of the
+        # sphere particle (method.md: fines-gravel adhesion = fines-wall adhesion). YADE's
+        # bond is cohesion x min(R_sphere, r_member)^2 with cohesion = F / R_sphere^2, so it
+        # is exact on members at least as large as the sphere and (r_member / R_sphere)^2
+        # of F on smaller ones.
+        masses = [self.particle_mass(n) for n in (a, b) if n in self.particles and not self.is_clump(n)]
+        if not masses:
+            raise RigFailure(f"materials.{a}.interactions.{b}.cohesion: cohesion without a sphere material "
+                             "in the pair (clump - clump or clump - wall) is not supported")
         return coh["force_fraction"] * min(masses) * self.gravity
 
     def ip2(self):
@@ -152,10 +198,17 @@ class ContactModel:
                     continue
                 ia, ib = self.mat_id[a], self.mat_id[b]
                 fric.append((ia, ib, math.atan(self.pair(a, b)["friction_coefficient"])))
-                r = min(self.radius(a), self.radius(b) if b in self.particles else self.radius(a))
+                r = self._bond_radius(a, b)
                 # YADE: adhesion = cohesion x min(R1, R2)^2 (facet radius is 2R, so min is R)
                 coh.append((ia, ib, self.cohesion_force(a, b) / r ** 2))
-        # boundary-boundary pairs (e.g. a sliding cell on a plate): frictionless unless a rig says otherwise
+        # boundary-boundary pairs (e.g. a rig's guide sphere on a facet): frictionless, no
+        # cohesion. They must be listed: the cohesion MatchMakers have no fallback value and
+        # an unlisted pair aborts YADE ("MatchMaker: no match for (i,j)").
+        bnames = list(self.boundaries)
+        for i, a in enumerate(bnames):
+            for b in bnames[i:]:
+                fric.append((self.mat_id[a], self.mat_id[b], 0.0))
+                coh.append((self.mat_id[a], self.mat_id[b], 0.0))
         return Ip2_CohFrictMat_CohFrictMat_CohFrictPhys(
             setCohesionOnNewContacts=True,
             frictAngle=MatchMaker(matches=fric, algo="avg"),

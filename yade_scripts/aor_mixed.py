@@ -1,0 +1,69 @@
+"""Rig 2 for a material set: cylinder-lift angle of repose of a mixed sample (M1 clumps
++ M2 + M3 spheres, lab-tests.md section 4: the -50 mm sample).
+
+Fill the 145 x 95 mm PVC cylinder on the steel table with the set's particles by mass
+(demlib.mixed: generated mass split by the components' mass fractions and the M1
+shapes' shares, random non-overlapping placement in a column, pour, settle, strike
+level: spheres above the rim are removed, lumps stay), lift the cylinder at
+lift_speed_m_s until clear, settle the pile, measure the sector angles of the whole
+slope and of the upper half of the pile height (pycal/post/aor_mixed.py). Every particle sphere,
+clump members included, is a particle of the profile.
+Outputs: pile_particles.csv (with material and clump id), pile_profile.csv,
+pile_upper_profile.csv, pile_side.png, result.json.
+Run: yade -j1 -x -n yade_scripts/aor_mixed.py job.json
+"""
+import os
+import sys
+
+_HERE = os.path.dirname(os.path.abspath(sys.argv[0]))  # yade -x: __file__ is not the script
+sys.path.insert(0, _HERE)
+sys.path.insert(0, os.path.dirname(_HERE))             # repo root: pycal.post (no yade inside)
+from demlib.jobio import run_rig, write_csv  # noqa: E402
+from demlib import mixed, rigs  # noqa: E402
+
+
+def build_pile(scene):
+    """Fill, lift, settle. Returns the entries of result.json about the run."""
+    from yade import O
+    p = scene.rig["procedure"]
+    cell = mixed.fill_cell_mixed(scene)
+    lift = rigs.lift_cylinder(scene, cell["cylinder_ids"], p["lift_speed_m_s"], p["lift_clearance_m"])
+    t_settle, n_fallen = rigs.settle_pile(scene, "pile settle")
+    info = {k: v for k, v in cell.items() if k not in ("cylinder_ids", "table_ids", "settle_time_s", "steps")}
+    info.update({
+        "lift_time_s": lift["lift_time_s"],
+        "lift_height_m": lift["lift_height_m"],
+        "settle_time_s": t_settle,
+        "fill_settle_time_s": cell["settle_time_s"],
+        "n_fallen_off": lift["n_fallen"] + n_fallen,
+        "n_clumps_in_pile": len(scene.clumps),
+        "steps": O.iter,
+    })
+    return info
+
+
+def main(job, out_dir):
+    from pycal.post import aor as aor_post, aor_mixed as post
+    scene = mixed.MixedScene(job)
+    info = build_pile(scene)
+    rows = scene.particle_rows()
+    write_csv(out_dir, "pile_particles.csv", ["x_m", "y_m", "z_m", "radius_m", "material", "clump_id"], rows)
+    whole, upper = post.measure(rows, scene.rig["measure"])
+    columns = ["sector", "r_edge_m", "z_m", "used_in_fit"]        # as demlib.rigs.measure_pile
+    write_csv(out_dir, "pile_profile.csv", columns, aor_post.profile_rows(whole))
+    write_csv(out_dir, "pile_upper_profile.csv", columns, aor_post.profile_rows(upper))
+    lift_mm_s = 1000 * scene.rig["procedure"]["lift_speed_m_s"]
+    try:
+        post.plot(rows, whole, upper, os.path.join(out_dir, "pile_side.png"),
+                  title=f"AoR {scene.material} seed {job['seed']} (lift {lift_mm_s:g} mm/s)")
+    except Exception as exc:  # a figure must not cost the run
+        print(f"warning: pile_side.png not drawn: {exc}", flush=True)
+    out = post.result_keys(whole, upper)
+    out.update({"n_particles": whole["n_particles"], "pile_height_m": whole["pile_height_m"],
+                "pile_radius_m": whole["pile_radius_m"]})
+    out.update(info)
+    return out
+
+
+if __name__ == "__main__" and os.path.basename(sys.argv[0]) == "aor_mixed.py":
+    run_rig(main)
