@@ -89,15 +89,23 @@ def solve_monotone(evaluate, target, x0, lo, hi, tolerance, max_evaluations=6, f
             return done(a)
         need_higher = target > max(a.mean, b.mean)
         go_up = need_higher == increasing
+        width = b.x - a.x
+        end = b if go_up else a
+        if (go_up and b.x >= hi) or (not go_up and a.x <= lo):
+            bound = "upper" if go_up else "lower"
+            return done(end, f"target {target:.4g} is beyond what the {bound} bound "
+                             f"{hi if go_up else lo} reaches ({end.mean:.4g})")
+        # secant extrapolation from the two points (x 1.3 to bracket), when their slope has
+        # the expected sign; else, or beyond 3 widths, a step of 2 widths
+        slope = (b.mean - a.mean) / width if width else 0.0
+        step = 2.0 * width
+        if slope != 0.0 and (slope > 0) == increasing:
+            step = min(max(1.3 * abs((target - end.mean) / slope), 0.5 * width), 3.0 * width)
         if go_up:
-            if b.x >= hi:
-                return done(b, f"target {target:.4g} is beyond what the upper bound {hi} reaches ({b.mean:.4g})")
-            nxt = ev(min(hi, b.x + 2.0 * (b.x - a.x)))
+            nxt = ev(min(hi, b.x + step))
             a, b = b, nxt
         else:
-            if a.x <= lo:
-                return done(a, f"target {target:.4g} is beyond what the lower bound {lo} reaches ({a.mean:.4g})")
-            nxt = ev(max(lo, a.x - 2.0 * (b.x - a.x)))
+            nxt = ev(max(lo, a.x - step))
             a, b = nxt, a
     # Illinois regula falsi inside [a, b]: a and b keep opposite misfit signs
     fa, fb = a.misfit(target), b.misfit(target)

@@ -24,7 +24,7 @@ import yaml
 
 from .. import CONFIG_DIR
 from ..configs import load_material, load_yaml, _Checker
-from ..errors import ConfigError
+from ..errors import ConfigError, RunError
 from ..jobs import resolve_job, _set_path
 from ..post import mean_std
 from .root1d import solve_monotone
@@ -199,6 +199,11 @@ class Study:
         if row is None:
             raise ConfigError(str(self.config_path), f"materials.{material}.from",
                               f"stage {src['stage']} of {src['material']} must run before")
+        if not row["met"] or math.isnan(row["value"]):
+            return {"parameter": "+".join(st["keys"]), "value": math.nan, "response": "",
+                    "response_mean": math.nan, "response_std": math.nan, "target": math.nan,
+                    "tolerance": math.nan, "met": False, "evaluations": 0,
+                    "message": f"not inherited: {src['material']} {src['stage']} was not met"}
         for k in st["keys"]:
             self.overrides[material][k] = row["value"]
         return {"parameter": "+".join(st["keys"]), "value": row["value"], "response": "",
@@ -217,7 +222,15 @@ class Study:
                 k += 1
                 self.log(f"[stage {k}/{n_stages}] {material}: {st['stage']}"
                          + (f" on rig {st['rig']}" if "rig" in st else ""))
-                row = stage_fn[st["stage"]](material, st)
+                try:
+                    row = stage_fn[st["stage"]](material, st)
+                except RunError as exc:
+                    # the rig cannot run at some parameter value: the stage is not met, the
+                    # study goes on with the values found so far
+                    row = {"parameter": "+".join(st.get("parameter", {}).get("keys", [])), "value": math.nan,
+                           "response": st.get("response", ""), "response_mean": math.nan,
+                           "response_std": math.nan, "target": math.nan, "tolerance": math.nan,
+                           "met": False, "message": f"runs failed: {exc}", "evaluations": 0}
                 row.update({"material": material, "stage": st["stage"]})
                 self.stage_rows.append(row)
                 self.log(f"  -> {row['parameter']} = {row['value']:.4g}: "

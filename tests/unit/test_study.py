@@ -168,3 +168,20 @@ materials:
     (row,) = Study(cfg, Stiff(), tmp_path / "out", log=lambda m: None).run()
     assert row["met"] and abs(math.log(row["value"] / 3.53e7)) <= 0.25
     assert row["value"] == float(f"{row['value']:.3g}")
+
+
+def test_a_stage_whose_runs_fail_is_not_met_and_the_study_goes_on(tmp_path, study_file):
+    from pycal.errors import RunError
+
+    class FailingAor(FakeExecutor):
+        def run(self, jobs):
+            if jobs[0]["rig"] == "aor" and jobs[0]["material"] == "M3-dry":
+                raise RunError("aor-M3-dry: no result (RIG FAILED: blow-up)")
+            return super().run(jobs)
+    rows = Study(study_file, FailingAor(), tmp_path / "out", log=lambda m: None).run()
+    by = {(r["material"], r["stage"]): r for r in rows}
+    assert by[("M3-dry", "density")]["met"]
+    assert not by[("M3-dry", "rolling_resistance")]["met"]
+    assert "blow-up" in by[("M3-dry", "rolling_resistance")]["message"]
+    assert not by[("M3-wet", "inherit")]["met"] and "was not met" in by[("M3-wet", "inherit")]["message"]
+    assert ("M3-wet", "cohesion") in by          # the study went on
