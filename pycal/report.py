@@ -47,8 +47,9 @@ def stage_figure(stage, history):
     ax1.set_ylabel(stage.get("response") or "response")
     ax1.set_title(f"{stage['material']}: {stage['stage']}")
     ax1.legend(fontsize=7)
-    for key in sorted({k for p in pts for k in p["parameters"]}):
-        ax2.plot(it, [p["parameters"].get(key, math.nan) for p in pts], "s-", label=key.split(".")[-1])
+    for key in sorted({k for p in pts for k in p["parameters"] if not k.startswith("rig.")}):
+        label = key.replace("interactions.", "").replace("_coefficient", "")
+        ax2.plot(it, [p["parameters"].get(key, math.nan) for p in pts], "s-", label=label)
     ax2.set_xlabel("evaluation")
     ax2.set_ylabel("parameter value")
     ax2.legend(fontsize=7)
