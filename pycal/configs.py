@@ -14,11 +14,23 @@ from . import CONFIG_DIR
 from .errors import ConfigError
 
 # Cohesion/adhesion models and their parameters (name -> (min, max) or None for no bound).
+# The YADE side (yade_scripts/demlib/contact_models.py) picks the contact-law family.
 COHESION_MODELS = {
     "none": {},
     # constant pull-off force = force_fraction x weight of the lighter particle,
     # acting in contact and up to adhesive_distance_m beyond it
     "force_fraction": {"force_fraction": (0.0, None), "adhesive_distance_m": (0.0, None)},
+    # Luding-type (demlib/contact_hysteretic.py): pull-off = force_fraction x weight of the
+    # lighter particle + pressure_fraction x the largest compressive force the contact has
+    # carried (sampled every update_interval_s of simulated time); acts in contact only
+    "hysteretic": {"force_fraction": (0.0, None), "pressure_fraction": (0.0, None),
+                   "update_interval_s": (1.0e-6, None)},
+    # Willett liquid bridge (demlib/contact_capillary.py; its own contact family: no rolling
+    # resistance, no other cohesion in the scene), material with itself only. Bridge volume
+    # = bridge_liquid_fraction x moisture x particle mass / water density x 2 / coordination_count;
+    # surface_tension_n_m is the stand-in's effective value (water 0.072 x R_stand-in / r_fines)
+    "liquid_bridge": {"surface_tension_n_m": (0.0, None), "contact_angle_deg": (0.0, 89.0),
+                      "bridge_liquid_fraction": (0.0, 1.0), "coordination_count": (1.0, None)},
 }
 
 # Suffixes that say a rig/numerics key's unit (SI) or that it is dimensionless.
@@ -158,17 +170,7 @@ def validate_material(data, path, partners):
         key = f"interactions.{partner}"
         if partner not in partners:
             c.fail(key, f"unknown partner (materials and boundaries: {', '.join(sorted(partners))})")
-        c.keys(props, key, ["friction_coefficient", "rolling_resistance_coefficient", "cohesion"])
-        c.number(props["friction_coefficient"], f"{key}.friction_coefficient", 0)
-        c.number(props["rolling_resistance_coefficient"], f"{key}.rolling_resistance_coefficient", 0)
-        coh = props["cohesion"]
-        if not isinstance(coh, dict) or "model" not in coh:
-            c.fail(f"{key}.cohesion", "must be a mapping with a 'model' key")
-        model = c.string(coh["model"], f"{key}.cohesion.model", list(COHESION_MODELS))
-        params = COHESION_MODELS[model]
-        c.keys(coh, f"{key}.cohesion", ["model"] + list(params))
-        for name, (lo, hi) in params.items():
-            c.number(coh[name], f"{key}.cohesion.{name}", lo, hi)
+        _check_pair_props(c, props, key)
     return data
 
 

@@ -12,7 +12,7 @@ from yade.wrapper import (ForceResetter, InsertionSortCollider, Bo1_Sphere_Aabb,
                           NewtonIntegrator, Sphere)
 from yade import Vector3
 
-from .contact import ContactModel
+from .contact_models import make_contact_model
 from .jobio import RigFailure
 
 
@@ -30,17 +30,15 @@ class Scene:
         self.material = job["material"]
         O.reset()
         random.seed(job["seed"])
-        self.contact = ContactModel(job, gravity=self.g)
+        self.contact = make_contact_model(job, gravity=self.g)   # family chosen by the cohesion models
         self.radius = self.contact.radius(self.material)
         self.newton = NewtonIntegrator(gravity=(0, 0, -self.g), damping=self.contact.damping(),
                                        dampGravity=True, label="newton")
         O.engines = [
             ForceResetter(),
-            InsertionSortCollider([Bo1_Sphere_Aabb(), Bo1_Facet_Aabb()]),
-            InteractionLoop([Ig2_Sphere_Sphere_ScGeom6D(), Ig2_Facet_Sphere_ScGeom6D()],
-                            [self.contact.ip2()], [self.contact.law2()]),
-            self.newton,
-        ]
+            InsertionSortCollider(self.contact.bounding_functors()),
+            InteractionLoop(self.contact.geometry_functors(), [self.contact.ip2()], [self.contact.law2()]),
+        ] + self.contact.extra_engines() + [self.newton]
         self.sphere_ids = []
         self.box_min = Vector3(-1, -1, -1)   # rig's bounding box for the escape guard (set by geometry)
         self.box_max = Vector3(1, 1, 1)
@@ -144,12 +142,15 @@ class Scene:
             if any(p[k] < self.box_min[k] or p[k] > self.box_max[k] for k in range(3)):
                 raise RigFailure(f"blow-up: particle {b.id} left the rig domain at {tuple(round(x, 4) for x in p)} "
                                  f"(t={O.time:.4f} s): it escaped or passed through a wall")
-        limit = self.num["max_overlap_fraction"] * self.radius
         for i in O.interactions:
-            if i.isReal and i.geom.penetrationDepth > limit:
+            if i.isReal and i.geom.penetrationDepth > self.overlap_limit_m(i):
                 raise RigFailure(f"blow-up: overlap {i.geom.penetrationDepth:.3g} m between bodies {i.id1} and "
                                  f"{i.id2} exceeds {self.num['max_overlap_fraction']} x radius at t={O.time:.4f} s "
                                  "(particles pass through each other or a wall)")
+
+    def overlap_limit_m(self, interaction):
+        """Largest overlap (m) the guard accepts on a contact: max_overlap_fraction x radius."""
+        return self.num["max_overlap_fraction"] * self.radius
 
     @staticmethod
     def advance(steps):

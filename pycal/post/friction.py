@@ -1,0 +1,303 @@
+"""Tilt-table friction rigs (wall_friction, internal_friction): friction vs consolidation
+stress over seeds, against the lab curves and bands; CSV, PNG and a misfit per curve.
+
+Pure Python (never imports YADE); works on result.json files:
+
+    /usr/bin/python3 -m pycal.post.friction runs/wall_friction/<job_id>/result.json [...] [--out DIR]
+
+Several results (seeds of one job) are pooled per consolidation stress: mean and sample
+standard deviation of mu_static and mu_dynamic over the seeds where the cell slid, and
+the share of seeds in which it stuck.
+
+Lab comparison (labresults/curves/<rig>_<lab_sample>.csv through pycal.labdata, or
+plain arrays given to `compare`): per quantity (mu_static, mu_dynamic) the misfit of
+pycal.post.compression.misfit: RMS over the lab steps where the lab cell slides of
+z = (sim - lab) / (half band width on the side of sim), the simulated mean curve
+interpolated in log(stress); |z| <= 1 is inside the band. Lab steps where the cell
+sticks are compared as outcomes: `outcome_mismatch_count` counts lab steps whose
+outcome (slides / sticks) differs from the simulated majority at the nearest simulated
+stress (within 5 %; farther steps are skipped).
+"""
+import csv
+import json
+import math
+import os
+import sys
+
+from . import mean_std
+from .compression import misfit, EXTRAPOLATE_RATIO
+
+QUANTITIES = ("mu_static", "mu_dynamic")
+RIGS = ("wall_friction", "internal_friction")
+
+
+# ------------------------------------------------------------------ statistics
+
+def seed_summary(results):
+    """Pool results (dicts) of one job over seeds, per consolidation stress.
+
+    Returns {'stress_pa': [...], 'n_seeds': [...], 'sticks_ratio': [...],
+    'mu_static_mean', 'mu_static_std', 'mu_static_n', same for mu_dynamic,
+    'max_tilt_deg_max'}; a mean is None where no seed slid."""
+    if not results:
+        raise ValueError("seed_summary: no results")
+    stresses = sorted({s for r in results for s in r["stress_pa"]})
+    out = {"stress_pa": stresses, "n_seeds": [], "sticks_ratio": [], "max_tilt_deg_max": []}
+    for q in QUANTITIES:
+        for suffix in ("mean", "std", "n"):
+            out[f"{q}_{suffix}"] = []
+    for s in stresses:
+        rows = []
+        for r in results:
+            if s in r["stress_pa"]:
+                rows.append({k: r[k][r["stress_pa"].index(s)] for k in QUANTITIES + ("sticks", "max_tilt_deg")
+                             if k in r})
+        out["n_seeds"].append(len(rows))
+        out["sticks_ratio"].append(sum(1 for x in rows if x.get("sticks")) / len(rows))
+        tilts = [x["max_tilt_deg"] for x in rows if x.get("max_tilt_deg") is not None]
+        out["max_tilt_deg_max"].append(max(tilts) if tilts else None)
+        for q in QUANTITIES:
+            vals = [x[q] for x in rows if x.get(q) is not None]
+            m, sd = mean_std(vals) if vals else (None, None)
+            out[f"{q}_mean"].append(m)
+            out[f"{q}_std"].append(sd)
+            out[f"{q}_n"].append(len(vals))
+    return out
+
+
+# ------------------------------------------------------------------ lab targets
+
+def lab_sample_of(result):
+    mat = result["job"]["materials"][result["material"]] if "job" in result else {}
+    return result.get("lab_sample") or mat.get("lab_sample")
+
+
+def load_targets(rig, lab_sample, lab_dir=None):
+    """{quantity: {'stress_pa', 'value', 'low', 'high', 'outcome'}} of the lab curve
+    <rig>_<lab_sample> (None where the lab cell sticks) plus '_name'; {} when there is
+    no such curve (or pycal.labdata cannot be used)."""
+    try:
+        from .. import labdata
+    except ImportError:      # pragma: no cover - labdata needs pandas
+        return {}
+    kw = {} if lab_dir is None else {"lab_dir": lab_dir}
+    name = f"{rig}_{lab_sample}"
+    if name not in labdata.curve_names(**kw):
+        return {}
+    df = labdata.load_curve(name, **kw)
+    out = {"_name": name}
+    for q in labdata.curve_quantities(df):
+        t = labdata.target_curve(name, q, **kw)
+
+        def clean(a):
+            return [None if (x is None or (isinstance(x, float) and math.isnan(x))) else float(x) for x in a]
+
+        out[q] = {"stress_pa": [float(x) for x in t.stress_pa], "value": clean(t.value), "low": clean(t.low),
+                  "high": clean(t.high), "outcome": [str(x) for x in t.outcome]}
+    return out
+
+
+def targets_from_arrays(stress_pa, value, low, high, outcome=None):
+    """One target in the form of load_targets from plain arrays (None/NaN = sticks)."""
+    def clean(a):
+        return [None if (x is None or (isinstance(x, float) and math.isnan(x))) else float(x) for x in a]
+    value = clean(value)
+    if outcome is None:
+        outcome = ["sticks" if v is None else "slides" for v in value]
+    return {"stress_pa": [float(s) for s in stress_pa], "value": value, "low": clean(low),
+            "high": clean(high), "outcome": list(outcome)}
+
+
+def _nearest(stresses, s):
+    """Index of the simulated stress within EXTRAPOLATE_RATIO of s, or None."""
+    best = min(range(len(stresses)), key=lambda i: abs(math.log(stresses[i] / s)))
+    return best if abs(math.log(stresses[best] / s)) <= math.log1p(EXTRAPOLATE_RATIO) else None
+
+
+def compare(summary, targets):
+    """{quantity: misfit dict + outcome counts + lab arrays} of a seed summary against
+    targets ({quantity: target} as load_targets gives; '_name' optional)."""
+    out = {}
+    for q in QUANTITIES:
+        t = targets.get(q)
+        if not t:
+            continue
+        slides = [i for i, o in enumerate(t["outcome"]) if o == "slides" and t["value"][i] is not None]
+        m = misfit(summary["stress_pa"], summary[f"{q}_mean"],
+                   [t["stress_pa"][i] for i in slides], [t["value"][i] for i in slides],
+                   [t["low"][i] for i in slides], [t["high"][i] for i in slides])
+        mismatch, compared = 0, 0
+        for i, s in enumerate(t["stress_pa"]):
+            k = _nearest(summary["stress_pa"], s)
+            if k is None:
+                continue
+            compared += 1
+            sim_sticks = summary["sticks_ratio"][k] > 0.5
+            if sim_sticks != (t["outcome"][i] == "sticks"):
+                mismatch += 1
+        m.update({"lab_curve": targets.get("_name", "arrays"), "quantity": q,
+                  "outcome_mismatch_count": mismatch, "outcome_compared_count": compared,
+                  "lab_stress_pa": [t["stress_pa"][i] for i in slides],
+                  "lab_value": [t["value"][i] for i in slides], "lab_low": [t["low"][i] for i in slides],
+                  "lab_high": [t["high"][i] for i in slides], "lab_all": t})
+        out[q] = m
+    return out
+
+
+# ------------------------------------------------------------------ outputs
+
+def write_summary_csv(summary, comparisons, path):
+    """friction_vs_stress.csv: per stress the seed statistics and the lab value and band
+    at that stress (blank where the lab has no step there)."""
+    cols = ["stress_pa", "n_seeds", "sticks_ratio", "max_tilt_deg_max"]
+    for q in QUANTITIES:
+        cols += [f"{q}_mean", f"{q}_std", f"{q}_n"]
+    lab_cols = []
+    for q in QUANTITIES:
+        if q in comparisons:
+            lab_cols += [f"lab_{q}", f"lab_{q}_low", f"lab_{q}_high", f"lab_{q}_outcome"]
+    tmp = path + ".part"
+    with open(tmp, "w", newline="") as f:
+        w = csv.writer(f)
+        w.writerow(cols + lab_cols)
+        for i, s in enumerate(summary["stress_pa"]):
+            row = ["" if summary[c][i] is None else summary[c][i] for c in cols]
+            for q in QUANTITIES:
+                if q not in comparisons:
+                    continue
+                t = comparisons[q]["lab_all"]
+                j = next((j for j, ls in enumerate(t["stress_pa"]) if abs(ls - s) <= 1e-6 * s), None)
+                if j is None:
+                    row += ["", "", "", ""]
+                else:
+                    row += ["" if t[k][j] is None else t[k][j] for k in ("value", "low", "high")] + [t["outcome"][j]]
+            w.writerow(row)
+    os.replace(tmp, path)
+    return path
+
+
+def write_comparison_csv(comparisons, path):
+    """lab_comparison.csv: per quantity and lab step (slides) lab value, band, sim, z."""
+    tmp = path + ".part"
+    with open(tmp, "w", newline="") as f:
+        w = csv.writer(f)
+        w.writerow(["quantity", "lab_curve", "stress_pa", "lab_value", "lab_low", "lab_high", "sim_value", "z_ratio"])
+        for q, c in comparisons.items():
+            for i, s in enumerate(c["lab_stress_pa"]):
+                sim, z = c["sim_at_lab"][i], c["z"][i]
+                w.writerow([q, c["lab_curve"], s, c["lab_value"][i], c["lab_low"][i], c["lab_high"][i],
+                            "" if sim is None else sim, "" if z is None else z])
+    os.replace(tmp, path)
+    return path
+
+
+def write_plot(summary, comparisons, path, title):
+    """friction_vs_stress.png: mean +/- std of mu_static and mu_dynamic vs stress (kPa),
+    the lab curves with their bands, sticking steps marked (x at the top)."""
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    fig, ax = plt.subplots(figsize=(7, 4.5))
+    colours = {"mu_static": "C0", "mu_dynamic": "C3"}
+    s_kpa = [s / 1e3 for s in summary["stress_pa"]]
+    for q in QUANTITIES:
+        pts = [(s, m, sd) for s, m, sd in zip(s_kpa, summary[f"{q}_mean"], summary[f"{q}_std"]) if m is not None]
+        if pts:
+            ax.errorbar([p[0] for p in pts], [p[1] for p in pts], yerr=[p[2] for p in pts], fmt="o-",
+                        color=colours[q], capsize=3, label=f"simulation {q}")
+        c = comparisons.get(q)
+        if c and c["lab_stress_pa"]:
+            ls = [s / 1e3 for s in c["lab_stress_pa"]]
+            ax.fill_between(ls, c["lab_low"], c["lab_high"], color=colours[q], alpha=0.15)
+            rms = "n/a" if c["rms_z"] is None else f"{c['rms_z']:.2f}"
+            ax.plot(ls, c["lab_value"], "--", color=colours[q], label=f"lab {q} (misfit {rms})")
+    ymax = ax.get_ylim()[1]
+    stuck = [s for s, r in zip(s_kpa, summary["sticks_ratio"]) if r > 0.5]
+    if stuck:
+        ax.plot(stuck, [ymax] * len(stuck), "kx", ms=9, label="simulated cell sticks")
+    for q in QUANTITIES:
+        c = comparisons.get(q)
+        if c:
+            t = c["lab_all"]
+            lab_stuck = [s / 1e3 for s, o in zip(t["stress_pa"], t["outcome"]) if o == "sticks"]
+            if lab_stuck:
+                ax.plot(lab_stuck, [ymax * 0.97] * len(lab_stuck), "s", mfc="none", color="k",
+                        label="lab cell sticks")
+            break
+    ax.set_xlabel("consolidation stress (kPa)")
+    ax.set_ylabel("friction coefficient (-)")
+    ax.set_title(title)
+    ax.grid(alpha=0.3)
+    ax.legend(fontsize=8)
+    fig.tight_layout()
+    tmp = path + ".part.png"
+    fig.savefig(tmp, dpi=110)
+    os.replace(tmp, path)
+    plt.close(fig)
+    return path
+
+
+def write_outputs(results, out_dir, lab_dir=None, targets=None, plots=True):
+    """CSV + PNG for one or several results (dicts or paths to result.json) of one job
+    (seeds). targets: as load_targets (default: the lab curve of the rig and the
+    material's lab_sample). Returns {'files', 'summary', 'misfits'} with compact misfits
+    {quantity: {'rms_z', 'n_points', 'inside_band_count', 'outcome_mismatch_count', ...}}."""
+    loaded = []
+    for r in results if isinstance(results, (list, tuple)) else [results]:
+        if isinstance(r, (str, os.PathLike)):
+            with open(r) as f:
+                r = json.load(f)
+        loaded.append(r)
+    rigs = {r["rig"] for r in loaded}
+    if len(rigs) != 1 or not rigs <= set(RIGS):
+        raise ValueError(f"write_outputs: results of one friction rig expected, got {sorted(rigs)}")
+    rig = rigs.pop()
+    summary = seed_summary(loaded)
+    if targets is None:
+        sample = lab_sample_of(loaded[0])
+        targets = load_targets(rig, sample, lab_dir) if sample else {}
+    comps = compare(summary, targets)
+    os.makedirs(out_dir, exist_ok=True)
+    files = [write_summary_csv(summary, comps, os.path.join(out_dir, "friction_vs_stress.csv"))]
+    if comps:
+        files.append(write_comparison_csv(comps, os.path.join(out_dir, "lab_comparison.csv")))
+    if plots:
+        title = f"{rig} {loaded[0]['material']} ({len(loaded)} seed{'s' if len(loaded) > 1 else ''})"
+        files.append(write_plot(summary, comps, os.path.join(out_dir, "friction_vs_stress.png"), title))
+    misfits = {q: {k: c[k] for k in ("rms_z", "n_points", "n_skipped", "inside_band_count",
+                                     "outcome_mismatch_count", "outcome_compared_count", "lab_curve")}
+               for q, c in comps.items()}
+    return {"files": files, "summary": summary, "misfits": misfits}
+
+
+def main(argv=None):
+    argv = sys.argv[1:] if argv is None else argv
+    out = None
+    if "--out" in argv:
+        i = argv.index("--out")
+        out = argv[i + 1]
+        argv = argv[:i] + argv[i + 2:]
+    if not argv:
+        print("usage: python3 -m pycal.post.friction RESULT.json [...] [--out DIR]", file=sys.stderr)
+        return 2
+    out = out or os.path.dirname(os.path.abspath(argv[0]))
+    res = write_outputs(argv, out)
+    for f in res["files"]:
+        print("wrote", f)
+    s = res["summary"]
+    for i, st in enumerate(s["stress_pa"]):
+        parts = [f"{st / 1e3:6.1f} kPa"]
+        for q in QUANTITIES:
+            m, sd = s[f"{q}_mean"][i], s[f"{q}_std"][i]
+            parts.append(f"{q} " + ("  n/a " if m is None else f"{m:.3f} +/- {sd:.3f}"))
+        parts.append(f"sticks {s['sticks_ratio'][i]:.2f}")
+        print("  ".join(parts))
+    for q, m in res["misfits"].items():
+        rms = "n/a" if m["rms_z"] is None else f"{m['rms_z']:.3g}"
+        print(f"misfit {q} vs {m['lab_curve']}: rms_z={rms} ({m['inside_band_count']}/{m['n_points']} inside "
+              f"the band; outcome mismatches {m['outcome_mismatch_count']}/{m['outcome_compared_count']})")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

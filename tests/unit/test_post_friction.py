@@ -1,0 +1,86 @@
+"""pycal.post.friction: seed statistics, lab comparison (bands, sticking steps), outputs."""
+import csv
+import json
+import math
+
+import pytest
+
+from pycal.post import friction
+
+
+def result(seed, mu_s, mu_d, sticks=None, stress=(3000, 40000, 86000), rig="wall_friction"):
+    n = len(stress)
+    return {"rig": rig, "material": "M2", "seed": seed, "stress_pa": list(stress),
+            "mu_static": list(mu_s), "mu_dynamic": list(mu_d),
+            "sticks": list(sticks or [False] * n), "max_tilt_deg": [30.0] * n,
+            "job": {"materials": {"M2": {"lab_sample": "gravel_dry"}}}}
+
+
+def test_seed_summary_mean_std_and_sticking():
+    rs = [result(1, [0.40, 0.50, None], [0.38, 0.48, None], sticks=[False, False, True]),
+          result(2, [0.44, 0.52, 0.60], [0.40, 0.50, 0.55])]
+    s = friction.seed_summary(rs)
+    assert s["stress_pa"] == [3000, 40000, 86000]
+    assert s["mu_static_mean"][0] == pytest.approx(0.42)
+    assert s["mu_static_std"][0] == pytest.approx(math.sqrt(2) * 0.02)
+    assert s["mu_static_n"][2] == 1 and s["mu_static_mean"][2] == pytest.approx(0.60)
+    assert s["sticks_ratio"] == [0.0, 0.0, 0.5]
+    assert s["n_seeds"] == [2, 2, 2]
+
+
+def test_compare_inside_band_is_small_misfit_and_outcomes():
+    s = friction.seed_summary([result(1, [0.40, 0.50, None], [0.40, 0.50, None], sticks=[False, False, True])])
+    t = friction.targets_from_arrays([3000, 40000, 86000], [0.40, 0.50, float("nan")],
+                                     [0.35, 0.45, float("nan")], [0.45, 0.55, float("nan")])
+    assert t["outcome"] == ["slides", "slides", "sticks"]
+    c = friction.compare(s, {"mu_static": t})["mu_static"]
+    assert c["rms_z"] == pytest.approx(0.0, abs=1e-12)
+    assert c["n_points"] == 2 and c["inside_band_count"] == 2
+    assert c["outcome_mismatch_count"] == 0 and c["outcome_compared_count"] == 3
+    # one band width too high everywhere -> rms z = 1; a slide where the lab sticks is a mismatch
+    s2 = friction.seed_summary([result(1, [0.45, 0.55, 0.7], [0.45, 0.55, 0.7])])
+    c2 = friction.compare(s2, {"mu_static": t})["mu_static"]
+    assert c2["rms_z"] == pytest.approx(1.0)
+    assert c2["outcome_mismatch_count"] == 1
+
+
+def test_compare_interpolates_in_log_stress():
+    s = friction.seed_summary([result(1, [0.3, 0.5], [0.3, 0.5], stress=(10000, 100000))])
+    t = friction.targets_from_arrays([math.sqrt(1e9)], [0.4], [0.3], [0.5])
+    c = friction.compare(s, {"mu_static": t})["mu_static"]
+    assert c["sim_at_lab"][0] == pytest.approx(0.4)
+
+
+def test_write_outputs_csv_png(tmp_path):
+    rs = [result(1, [0.40, 0.50, 0.52], [0.38, 0.48, 0.50]), result(2, [0.42, 0.50, 0.50], [0.40, 0.47, 0.49])]
+    paths = []
+    for r in rs:
+        p = tmp_path / f"r{r['seed']}.json"
+        p.write_text(json.dumps(r))
+        paths.append(str(p))
+    t = friction.targets_from_arrays([3000, 40000, 86000], [0.40, 0.50, 0.50], [0.35, 0.45, 0.45],
+                                     [0.45, 0.55, 0.55])
+    out = friction.write_outputs(paths, str(tmp_path / "out"), targets={"mu_static": t, "mu_dynamic": t,
+                                                                        "_name": "test"})
+    names = sorted(p.rsplit("/", 1)[1] for p in out["files"])
+    assert names == ["friction_vs_stress.csv", "friction_vs_stress.png", "lab_comparison.csv"]
+    rows = list(csv.DictReader(open(tmp_path / "out" / "friction_vs_stress.csv")))
+    assert len(rows) == 3 and float(rows[0]["mu_static_mean"]) == pytest.approx(0.41)
+    assert rows[0]["lab_mu_static"] == "0.4"
+    assert out["misfits"]["mu_static"]["n_points"] == 3
+    assert out["misfits"]["mu_static"]["lab_curve"] == "test"
+
+
+def test_lab_curve_of_the_shipped_data():
+    """The shipped lab curves load (when pandas is there) and a sticking lab step counts."""
+    pytest.importorskip("pandas")
+    t = friction.load_targets("internal_friction", "fines_wet")
+    assert t["_name"] == "internal_friction_fines_wet"
+    assert "sticks" in t["mu_static"]["outcome"]
+    assert friction.load_targets("wall_friction", "no_such_sample") == {}
+
+
+def test_mixed_rigs_rejected(tmp_path):
+    with pytest.raises(ValueError):
+        friction.write_outputs([result(1, [0.4] * 3, [0.4] * 3), result(2, [0.4] * 3, [0.4] * 3, rig="ccs")],
+                               str(tmp_path))

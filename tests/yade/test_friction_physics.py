@@ -1,0 +1,217 @@
+"""Physics of the tilt-table friction rigs and of the cohesion laws (real YADE runs).
+
+Wall-friction jobs go through pycal.jobs.resolve_job + pycal.runner.run_job into a
+pytest tmp folder (M2, seed 1, -j1: bit-reproducible). To make the answer known, the
+particles cannot roll (rolling resistance 1.0 on every pair: a sphere bed with rolling
+resistance 0.35 rolls on the plate below the sliding friction, so its wall friction is
+a bulk property, not the contact value); the bed must then slide at tan(angle) = mu of
+the particle-steel pair, as long as the contents are stronger than that contact: the
+loose struck fill (solid fraction ~0.37) shears inside itself at a stress ratio of
+~0.26 - 0.36 (measured: mu = 0.35 read 0.262, mu = 0.5 read 0.365 at 3 kPa, mu = 0 for
+the particle pairs read even less), as a lab wall-friction test measures the weaker of
+wall and internal friction. So the resolution is tested at mu = 0.1, 0.2, 0.3 on the
+fresh fill and at mu = 0.5 after a 40 kPa consolidation (read 0.512).
+
+Bounds, from measurements of these scenes (tilt 2 deg/s, onset 1 mm, travel 10 mm):
+- resolution: mu = 0.3 read 0.2997, mu = 0.2 read 0.2125 (3 kPa) / 0.2142 (40 kPa),
+  mu = 0.5 read 0.512 (40 kPa); the reading is late by the slide needed to reach the
+  1 mm onset (0.2952 / 0.2997 / 0.3072 at 1 / 2 / 4 deg/s for mu = 0.3 at 3 kPa)
+  -> |mu_static - mu| <= 0.03 (the issue's resolution);
+- dynamic friction from the timed travel: 0.2928 (mu = 0.3), 0.198 / 0.200 (mu = 0.2),
+  0.499 (mu = 0.5, 40 kPa) -> within 0.03 of mu and not above the static reading;
+- no cohesion, mu = 0.2: 0.2125 at 3 kPa, 0.2142 at 40 kPa -> |rise| <= 0.03;
+- hysteretic cohesion (pressure_fraction 0.02 on the particle-steel pair, mu = 0.2):
+  0.296 at 3 kPa, 0.446 at 40 kPa (no cohesion: 0.214) -> rise >= 0.1 and >= 0.15 above
+  the cohesionless reading (M3-dry start values with the same law: 0.23 -> 0.97);
+- two spheres, the lower one hanging from a fixed one by a fresh bond: force_fraction
+  1.5 holds (displacement < 1 mm after 0.5 s), 0.5 parts (> 5 mm); hysteretic with
+  force_fraction 0.5 parts when not pressed and holds after being pressed with 20 x its
+  weight and released over 0.3 s (pressure_fraction 0.1: pull-off 0.5 + 1.9 weights; a
+  sudden release rebounds into tension beyond that and parts them).
+"""
+import json
+import os
+import shutil
+import subprocess
+import textwrap
+from pathlib import Path
+
+import pytest
+
+from pycal import REPO_ROOT
+from pycal.jobs import resolve_job
+from pycal.runner import run_job
+
+pytestmark = [pytest.mark.yade,
+              pytest.mark.skipif(shutil.which("yade") is None, reason="yade is not installed")]
+
+SEED = 1
+NO_ROLL = {"interactions.M2.rolling_resistance_coefficient": 1.0,
+           "interactions.steel.rolling_resistance_coefficient": 1.0,
+           "interactions.pvc.rolling_resistance_coefficient": 1.0}
+RESOLUTION = 0.03
+HYSTERETIC = {"model": "hysteretic", "force_fraction": 0.05, "pressure_fraction": 0.02,
+              "update_interval_s": 0.01}
+
+_RUNS = {}
+
+
+def wall(tmp_path_factory, name, mu, stresses, cohesion=None):
+    """One wall-friction run (cached per session)."""
+    if name not in _RUNS:
+        o = dict(NO_ROLL)
+        o["interactions.steel.friction_coefficient"] = mu
+        o["rig.procedure.consolidation_stresses_pa"] = stresses
+        if cohesion is not None:
+            o["interactions.steel.cohesion"] = cohesion
+        job = resolve_job("wall_friction", "M2", o, seed=SEED)
+        _RUNS[name] = run_job(job, runs_dir=tmp_path_factory.mktemp(name), timeout_s=900)
+    return _RUNS[name]
+
+
+# mu -> consolidation stresses of the run, and which steps must read mu
+CASES = {0.1: ([3000], [0]), 0.2: ([3000, 40000], [0, 1]), 0.3: ([3000], [0]), 0.5: ([3000, 40000], [1])}
+
+
+@pytest.mark.parametrize("mu", sorted(CASES))
+def test_cell_slides_at_tan_angle_equal_mu(tmp_path_factory, mu):
+    stresses, steps = CASES[mu]
+    r = wall(tmp_path_factory, f"mu{mu}", mu, stresses)
+    for k in steps:
+        assert not r["sticks"][k]
+        assert abs(r["mu_static"][k] - mu) <= RESOLUTION, (stresses[k], r["mu_static"][k])
+        assert abs(r["mu_dynamic"][k] - mu) <= RESOLUTION, (stresses[k], r["mu_dynamic"][k])
+        # the plate's own force ratio at the onset tells the same
+        assert abs(r["plate_force_ratio_onset"][k] - mu) <= RESOLUTION
+
+
+@pytest.mark.parametrize("mu", sorted(CASES))
+def test_dynamic_not_above_static(tmp_path_factory, mu):
+    stresses, steps = CASES[mu]
+    r = wall(tmp_path_factory, f"mu{mu}", mu, stresses)
+    for k in steps:
+        assert r["mu_dynamic"][k] <= r["mu_static"][k]
+
+
+def test_no_rise_with_consolidation_without_cohesion(tmp_path_factory):
+    r = wall(tmp_path_factory, "mu0.2", 0.2, CASES[0.2][0])
+    assert r["stress_pa"] == [3000, 40000]
+    assert abs(r["mu_static"][1] - r["mu_static"][0]) <= RESOLUTION
+    # the spring curve of both loads was recorded and reached the targets
+    assert len(r["spring_curve"]["lid_position_m"]) > 4
+    for want, got in zip([3000, 40000], r["stress_reached_pa"]):
+        assert abs(got - want) <= 0.02 * want
+
+
+def test_hysteretic_cohesion_friction_rises_with_consolidation(tmp_path_factory):
+    base = wall(tmp_path_factory, "mu0.2", 0.2, CASES[0.2][0])
+    r = wall(tmp_path_factory, "hyst", 0.2, CASES[0.2][0], cohesion=HYSTERETIC)
+    assert r["mu_static"][1] - r["mu_static"][0] >= 0.1
+    assert r["mu_static"][1] - base["mu_static"][1] >= 0.15
+
+
+# ---------------------------------------------------------------- two spheres
+
+PAIR_SCENE = textwrap.dedent('''
+    """Two spheres: A fixed, B hanging below it by a fresh bond (contact.py family of
+    the job); optionally B is first pressed up against A with press_weights x its weight."""
+    import json, os, sys
+    sys.path.insert(0, os.path.join(sys.argv[2], "yade_scripts"))
+    from yade import O, utils, Vector3
+    from demlib.scene import Scene
+
+    def case(job, press):
+        sc = Scene(job)
+        r = sc.radius
+        m = sc.contact.mat_id[job["material"]]
+        a = O.bodies.append(utils.sphere((0, 0, 0.2), r, material=m, fixed=True))
+        b = O.bodies.append(utils.sphere((0, 0, 0.2 - 2 * r + 1e-6), r, material=m))
+        sc.set_timestep()
+        w = O.bodies[b].state.mass * sc.g
+        O.step()
+        if press:      # press up against A, then release slowly (a sudden release rebounds)
+            for k in range(41):
+                f = press * w * min(1.0, k / 10.0) if k <= 10 else press * w * (40 - k) / 30.0
+                O.forces.setPermF(b, Vector3(0, 0, f))
+                sc.advance(int(0.01 / O.dt))
+            O.forces.setPermF(b, Vector3(0, 0, 0))
+        z0 = O.bodies[b].state.pos[2]
+        sc.advance(int(0.5 / O.dt))
+        return z0 - O.bodies[b].state.pos[2]
+
+    job = json.load(open(sys.argv[1]))
+    out = {name: case(j, press) for name, (j, press) in
+           ((n, (job["cases"][n]["job"], job["cases"][n]["press"])) for n in job["cases"])}
+    json.dump(out, open("pair.json", "w"))
+    sys.stdout.flush()
+    os._exit(0)
+''')
+
+
+@pytest.fixture(scope="module")
+def pair(tmp_path_factory):
+    d = tmp_path_factory.mktemp("pair")
+
+    def job(coh):
+        return resolve_job("wall_friction", "M2", {"interactions.M2.cohesion": coh}, seed=SEED)
+
+    cases = {
+        "ff_above": {"job": job({"model": "force_fraction", "force_fraction": 1.5, "adhesive_distance_m": 0.0}),
+                     "press": 0},
+        "ff_below": {"job": job({"model": "force_fraction", "force_fraction": 0.5, "adhesive_distance_m": 0.0}),
+                     "press": 0},
+        "hyst_unpressed": {"job": job({"model": "hysteretic", "force_fraction": 0.5, "pressure_fraction": 0.1,
+                                       "update_interval_s": 0.005}), "press": 0},
+        "hyst_pressed": {"job": job({"model": "hysteretic", "force_fraction": 0.5, "pressure_fraction": 0.1,
+                                     "update_interval_s": 0.005}), "press": 20},
+    }
+    (d / "cases.json").write_text(json.dumps({"cases": cases}))
+    (d / "pair.py").write_text(PAIR_SCENE)
+    proc = subprocess.run(["yade", "-j1", "-x", "-n", "pair.py", "cases.json", str(REPO_ROOT)], cwd=d,
+                          capture_output=True, text=True, timeout=300, env={**os.environ, "OMP_NUM_THREADS": "1"})
+    out = d / "pair.json"
+    assert proc.returncode == 0 and out.is_file(), proc.stdout[-2000:] + proc.stderr[-2000:]
+    return json.loads(out.read_text())
+
+
+def test_bond_above_weight_holds_below_parts(pair):
+    assert pair["ff_above"] < 0.001
+    assert pair["ff_below"] > 0.005
+
+
+def test_hysteretic_bond_grows_with_pressing(pair):
+    assert pair["hyst_unpressed"] > 0.005
+    assert pair["hyst_pressed"] < 0.001
+
+
+def test_liquid_bridge_holds_when_stronger_than_weight(tmp_path_factory):
+    """Willett bridge between two stand-ins (contact_capillary family): with an effective
+    surface tension whose largest bridge force 2 pi R gamma is 3x the weight the lower
+    sphere hangs; at 1/3 of the weight it falls."""
+    d = tmp_path_factory.mktemp("bridge")
+    base = {"interactions.M2.rolling_resistance_coefficient": 0.0,
+            "interactions.steel.rolling_resistance_coefficient": 0.0,
+            "interactions.pvc.rolling_resistance_coefficient": 0.0,
+            "interactions.M3-dry.rolling_resistance_coefficient": 0.0,
+            "interactions.M1.rolling_resistance_coefficient": 0.0,
+            "moisture_percent_dry_basis": 5.4}
+    weight = 2750 * 4.0 / 3.0 * 3.141592653589793 * 0.0125 ** 3 * 9.81
+    gamma_for = lambda ratio: ratio * weight / (2 * 3.141592653589793 * 0.0125)   # noqa: E731
+
+    def job(ratio):
+        o = dict(base)
+        o["interactions.M2.cohesion"] = {"model": "liquid_bridge", "surface_tension_n_m": gamma_for(ratio),
+                                         "contact_angle_deg": 0.0, "bridge_liquid_fraction": 0.2,
+                                         "coordination_count": 6}
+        return resolve_job("wall_friction", "M2", o, seed=SEED)
+
+    cases = {"strong": {"job": job(3.0), "press": 0}, "weak": {"job": job(1.0 / 3.0), "press": 0}}
+    (d / "cases.json").write_text(json.dumps({"cases": cases}))
+    (d / "pair.py").write_text(PAIR_SCENE)
+    proc = subprocess.run(["yade", "-j1", "-x", "-n", "pair.py", "cases.json", str(REPO_ROOT)], cwd=d,
+                          capture_output=True, text=True, timeout=300, env={**os.environ, "OMP_NUM_THREADS": "1"})
+    out = d / "pair.json"
+    assert proc.returncode == 0 and out.is_file(), proc.stdout[-2000:] + proc.stderr[-2000:]
+    res = json.loads(out.read_text())
+    assert res["strong"] < 0.002
+    assert res["weak"] > 0.005
