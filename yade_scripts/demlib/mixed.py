@@ -190,12 +190,7 @@ def placed_masses(placements):
 def _scene_class():
     """MixedScene is defined on first use so that this module imports without YADE."""
     from yade import O, utils
-    from yade.wrapper import (ForceResetter, InsertionSortCollider, Bo1_Sphere_Aabb, Bo1_Facet_Aabb,
-                              InteractionLoop, Ig2_Sphere_Sphere_ScGeom6D, Ig2_Facet_Sphere_ScGeom6D,
-                              NewtonIntegrator)
-    from yade import Vector3
     from .scene import Scene
-    from .contact import ContactModel
     from .jobio import RigFailure
 
     class MixedScene(Scene):
@@ -209,37 +204,22 @@ def _scene_class():
         length scale of the rest criterion and of the fall-off threshold)."""
 
         def __init__(self, job):
-            self.job = job
-            self.rig = job["rig_config"]
-            self.num = self.rig["numerics"]
-            self.g = self.num["gravity_m_s2"]
-            self.material = job["material"]
-            O.reset()
-            random.seed(job["seed"])
-            self.contact = ContactModel(job, gravity=self.g)
-            radii = [self.contact.radius(n) for n in job["materials"] if not self.contact.is_clump(n)]
-            if not radii:   # clumps only: the smallest member radius of any lump
-                radii = [clumps.shape_members(s, c["min_size_m"])[1]
-                         for n in job["materials"] for c in job["materials"][n]["particles"]["size_classes"]
-                         for s in job["materials"][n]["particles"]["shapes"].values()]
-            self.radius = min(radii)
-            self.newton = NewtonIntegrator(gravity=(0, 0, -self.g), damping=self.contact.damping(),
-                                           dampGravity=True, label="newton")
-            O.engines = [
-                ForceResetter(),
-                InsertionSortCollider([Bo1_Sphere_Aabb(), Bo1_Facet_Aabb()]),
-                InteractionLoop([Ig2_Sphere_Sphere_ScGeom6D(), Ig2_Facet_Sphere_ScGeom6D()],
-                                [self.contact.ip2()], [self.contact.law2()]),
-                self.newton,
-            ]
-            self.sphere_ids = []
+            Scene.__init__(self, job)
             self.free_ids = []
             self.clumps = {}
             self.member_of = {}
-            self.box_min = Vector3(-1, -1, -1)
-            self.box_max = Vector3(1, 1, 1)
-            self.n_guard_checks = 0
             self.name_of_mat = {v: k for k, v in self.contact.mat_id.items()}
+
+        def length_scale(self):
+            """The smallest sphere radius of the set's sphere materials (clumps only: the
+            smallest member radius of any lump)."""
+            job = self.job
+            radii = [self.contact.radius(n) for n in job["materials"] if not self.contact.is_clump(n)]
+            if not radii:
+                radii = [clumps.shape_members(s, c["min_size_m"])[1]
+                         for n in job["materials"] for c in job["materials"][n]["particles"]["size_classes"]
+                         for s in job["materials"][n]["particles"]["shapes"].values()]
+            return min(radii)
 
         # ---------- particles
         def add_placements(self, placements):

@@ -31,7 +31,7 @@ class Scene:
         O.reset()
         random.seed(job["seed"])
         self.contact = make_contact_model(job, gravity=self.g)   # family chosen by the cohesion models
-        self.radius = self.contact.radius(self.material)
+        self.radius = self.length_scale()
         self.newton = NewtonIntegrator(gravity=(0, 0, -self.g), damping=self.contact.damping(),
                                        dampGravity=True, label="newton")
         O.engines = [
@@ -43,6 +43,10 @@ class Scene:
         self.box_min = Vector3(-1, -1, -1)   # rig's bounding box for the escape guard (set by geometry)
         self.box_max = Vector3(1, 1, 1)
         self.n_guard_checks = 0
+
+    def length_scale(self):
+        """Particle radius (m) that scales the rest criterion and the guards."""
+        return self.contact.radius(self.material)
 
     # ---------- geometry ----------
     def add_cylinder(self, diameter, height, segments, material, z0=0.0):
