@@ -189,7 +189,7 @@ def placed_masses(placements):
 
 def _scene_class():
     """MixedScene is defined on first use so that this module imports without YADE."""
-    from yade import O, utils
+    from yade import O, utils, Vector3
     from .scene import Scene
     from .jobio import RigFailure
 
