@@ -280,16 +280,6 @@ def _scene_class():
                 f += O.forces.f(m)
             return f
 
-        def unbalanced_force_ratio(self):
-            forces = [i.phys.normalForce.norm() for i in O.interactions if i.isReal]
-            mean_contact = sum(forces) / len(forces) if forces else 0.0
-            if mean_contact == 0.0:
-                return 0.0
-            grav = self.newton.gravity
-            bodies = self.dynamic_bodies()
-            resid = sum((self.body_force(b) + grav * b.state.mass).norm() for b in bodies) / len(bodies)
-            return resid / mean_contact
-
         def overlap_limit_m(self, interaction):
             """The overlap limit relative to the smaller sphere of the pair (clump members vary)."""
             radii = [getattr(O.bodies[k].shape, "radius", None) for k in (interaction.id1, interaction.id2)]

@@ -127,9 +127,17 @@ class Scene:
         if mean_contact == 0.0:
             return 0.0
         grav = self.newton.gravity
-        spheres = self.live_spheres()
-        resid = sum((O.forces.f(b.id) + grav * b.state.mass).norm() for b in spheres) / len(spheres)
+        bodies = self.dynamic_bodies()
+        resid = sum((self.body_force(b) + grav * b.state.mass).norm() for b in bodies) / len(bodies)
         return resid / mean_contact
+
+    def dynamic_bodies(self):
+        """The bodies that move freely (here the particle spheres)."""
+        return self.live_spheres()
+
+    def body_force(self, body):
+        """Contact force on a body of dynamic_bodies() (N)."""
+        return O.forces.f(body.id)
 
     def is_at_rest(self):
         if self.kinetic_energy_ratio() > self.num["rest_kinetic_energy_ratio"]:
