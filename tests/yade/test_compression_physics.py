@@ -160,3 +160,17 @@ def test_ucs_pile_under_the_plate(tmp_path_factory):
     assert r["reference_area_m2"] == pytest.approx(3.14159265 * 0.145 ** 2 / 4)
     assert 0 < r["strain"][0] < r["strain"][1] < 0.5
     assert r["initial_height_m"] < 0.095 + 0.0125           # a pile, lower than the filled cell's top
+    assert r["load_stopped_at_pa"] is None and r["load_steps_completed_count"] == 2
+
+
+def test_ucs_loading_stops_at_the_overlap_limit_with_the_steps_reached(tmp_path_factory):
+    """A free pile carries the plate on a few contacts: past the overlap limit the UCS
+    curve ends at the last step reached, says so, and keeps the valid steps (this
+    scene: 3 kPa gives overlaps of ~0.05 R, 12 kPa ~0.13-0.16 R; the limit is set to 0.09 R)."""
+    r = run(tmp_path_factory, "ucs", dict(UCS_SHORT, **{"rig.numerics.max_overlap_fraction": 0.09}), "ucs_limited")
+    assert r["load_steps_completed_count"] == 1
+    assert r["load_stopped_at_pa"] == 12000
+    assert "overlap" in r["load_stop_reason"]
+    assert len(r["stress_pa"]) == len(r["strain"]) == len(r["stiffness_pa"]) == 1
+    assert r["max_overlap_ratio"][0] < 0.09
+    assert r["stress_pa"][0] == pytest.approx(3000, rel=0.03)

@@ -23,6 +23,12 @@ class RigFailure(Exception):
     """The rig cannot give a valid result (blow-up, escape, no rest...)."""
 
 
+class OverlapLimitExceeded(RigFailure):
+    """A contact overlaps more than numerics.max_overlap_fraction x radius: the contact
+    law is outside its range (or particles pass through each other). Rigs that can stop
+    early with a valid partial result (UCS loading) catch this one."""
+
+
 def job_path_from_argv():
     """The job file: yade-batch's table column `jobFile`, else the first script argument."""
     try:

@@ -13,7 +13,7 @@ from yade.wrapper import (ForceResetter, InsertionSortCollider, Bo1_Sphere_Aabb,
 from yade import Vector3
 
 from .contact_models import make_contact_model
-from .jobio import RigFailure
+from .jobio import RigFailure, OverlapLimitExceeded
 
 
 class Scene:
@@ -156,7 +156,7 @@ class Scene:
                                  f"(t={O.time:.4f} s): it escaped or passed through a wall")
         for i in O.interactions:
             if i.isReal and i.geom.penetrationDepth > self.overlap_limit_m(i):
-                raise RigFailure(f"blow-up: overlap {i.geom.penetrationDepth:.3g} m between bodies {i.id1} and "
+                raise OverlapLimitExceeded(f"blow-up: overlap {i.geom.penetrationDepth:.3g} m between bodies {i.id1} and "
                                  f"{i.id2} exceeds {self.num['max_overlap_fraction']} x radius at t={O.time:.4f} s "
                                  "(particles pass through each other or a wall)")
 
