@@ -42,9 +42,10 @@ def build(scene):
 
 
 def main(job, out_dir):
-    scene = Scene(job)
-    parts = build(scene)
-    return tl.run_friction_rig(scene, parts, out_dir)
+    def make_scene():
+        scene = Scene(job)
+        return scene, build(scene)
+    return tl.run_friction_rig(make_scene, out_dir)
 
 
 run_rig(main)

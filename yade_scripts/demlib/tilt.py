@@ -292,7 +292,7 @@ def consolidate(scene, lid, cell, plate_ids, stress_pa, area, proc, curve, step_
 
 
 # ------------------------------------------------------------------ tilt test
-def tilt_test(scene, tilt, cell, lid, plate_ids, spill_box, proc, record, step_index):
+def tilt_test(scene, tilt, cell, lid, plate_ids, spill_box, proc, record, step_index, restore=True):
     """One tilt test from the horizontal at rest.
 
     The lid is joined to the cell (one rigid body hanging on the contents through the lid
@@ -302,10 +302,13 @@ def tilt_test(scene, tilt, cell, lid, plate_ids, spill_box, proc, record, step_i
     x = v0 t + a t^2 / 2, mu_d = tan t - a / (g cos t)). If the cell stalls before the
     travel is done (moves less than 1 % of it in dynamic_stall_time_s, or the hold lasts
     dynamic_max_time_s), the tilt resumes until the cell has slid the onset distance again
-    and the hold is repeated there (dynamic_restarts_count); if max_tilt_deg is reached
+    and the hold is repeated there (dynamic_restarts_count; between holds the table tilts at
+    tilt_restart_rate_deg_s: the static reading is done, and mu_dynamic comes from the
+    acceleration at the held angle, not from how fast it was reached); if max_tilt_deg is reached
     before a full travel, the cell sticks (sticks: true, mu_dynamic: null). Then the cell
     is stopped (all velocities zeroed, as the operator catches it), the table tilted back
-    and the scene settled. Particles that leave spill_box are erased and counted.
+    and the scene settled (restore=False: not, the scene is discarded after the step).
+    Particles that leave spill_box are erased and counted.
 
     Particle damping during the tilt follows proc['particle_damping_during_tilt']:
     'damped' (Cundall damping kept), 'undamped' (off from the start of the tilt),
@@ -315,6 +318,7 @@ def tilt_test(scene, tilt, cell, lid, plate_ids, spill_box, proc, record, step_i
     Returns a dict of the step's measurements.
     """
     rate = proc["tilt_rate_deg_s"]
+    restart_rate = proc["tilt_restart_rate_deg_s"]
     max_tilt = proc["max_tilt_deg"]
     onset_d = proc["slide_onset_displacement_m"]
     travel_d = proc["dynamic_travel_distance_m"]
@@ -429,7 +433,7 @@ def tilt_test(scene, tilt, cell, lid, plate_ids, spill_box, proc, record, step_i
             ratios = []
             x_stop = cell.pos[0] - x0
             while angle < max_tilt:
-                angle = min(max_tilt, angle + rate * dt_chunk)
+                angle = min(max_tilt, angle + restart_rate * dt_chunk)
                 tilt.set(angle)
                 x, f = step_chunk()
                 if x - x_stop >= onset_d:
@@ -453,6 +457,9 @@ def tilt_test(scene, tilt, cell, lid, plate_ids, spill_box, proc, record, step_i
         "cell_gap_start_m": gap0,
         "tilt_time_s": O.time - t0,
     })
+    if not restore:
+        out["spilled_particles_count"] = spilled[0]
+        return out
     # --- stop the cell, tilt back, settle
     stop_all([cell.id] + list(scene.sphere_ids))
     set_damped(scene.sphere_ids, True)
@@ -495,9 +502,18 @@ STEP_KEYS = ("mu_static", "mu_dynamic", "sticks", "max_tilt_deg", "onset_angle_d
              "wall_time_step_s")
 
 
-def run_friction_rig(scene, parts, out_dir):
-    """Lid, then for each consolidation stress in order (same fill): consolidate, tilt
-    test. `parts`: plate_ids (bearing plate: force readout; empty for the internal rig),
+FILL_MODES = ("sequential", "fresh")
+
+
+def run_friction_rig(make_scene, out_dir):
+    """For each consolidation stress in order: consolidate, tilt test.
+
+    make_scene() -> (scene, parts) builds and fills the rig (a new YADE scene).
+    procedure.fill_each_step: 'sequential' - one fill, the steps follow each other on it
+    (the lab's procedure: the table returns to horizontal, the cell is put back);
+    'fresh' - a new fill for every step (same seed, so the same fill: the steps differ
+    only by their consolidation stress), for rigs whose sample is spoilt by a slide.
+    `parts`: plate_ids (bearing plate: force readout; empty for the internal rig),
     cell (RigidBody, the sliding cell), cell_bottom_z_m (its nominal bottom edge),
     floor_z_m (lowest a lid may go), spill_box_m (x_min, x_max, y_min, y_max, z_min: a
     particle whose centre leaves it has spilled off the table: erased and counted),
@@ -505,18 +521,28 @@ def run_friction_rig(scene, parts, out_dir):
     spring_curve.csv, tilt_record.csv; returns the measurements."""
     import time
     from .jobio import write_csv
+    scene, parts = make_scene()
     g, p = scene.rig["geometry"], scene.rig["procedure"]
-    cell, plate_ids = parts["cell"], parts["plate_ids"]
+    fresh = p["fill_each_step"] == "fresh"
+    if p["fill_each_step"] not in FILL_MODES:
+        raise RigFailure(f"procedure.fill_each_step: {p['fill_each_step']!r} must be one of {', '.join(FILL_MODES)}")
     d = g["cell_inner_diameter_m"]
     area = math.pi * d * d / 4.0
-    spheres = scene.live_spheres()
-    if not spheres:
-        raise RigFailure("fill: no particle left in the cell")
-    top = max(b.state.pos[2] + b.shape.radius for b in spheres)
-    lid = Lid(scene, d, g["lid_material"], top + p["plate_start_gap_m"], g["lid_mass_kg"])
-    tilt = Tilt(scene)
+
+    def start(scene, parts):
+        spheres = scene.live_spheres()
+        if not spheres:
+            raise RigFailure("fill: no particle left in the cell")
+        top = max(b.state.pos[2] + b.shape.radius for b in spheres)
+        lid = Lid(scene, d, g["lid_material"], top + p["plate_start_gap_m"], g["lid_mass_kg"])
+        return lid, Tilt(scene)
+
+    lid, tilt = start(scene, parts)
     particle_ids = list(scene.sphere_ids)
     mass_particles = scene.particle_mass_total()
+    settle_s = parts["settle_time_s"]
+    cohesion_updates = 0
+    steps_done = 0          # time steps of the scenes already discarded (fresh fills)
     steps, curve, record = [], [], []
     keys = ("stress_pa",) + STEP_KEYS
 
@@ -532,15 +558,22 @@ def run_friction_rig(scene, parts, out_dir):
     try:
         for k, stress in enumerate(p["consolidation_stresses_pa"]):
             w0 = time.time()
+            if fresh and k:
+                cohesion_updates += getattr(scene.contact, "n_updates", 0) or 0
+                steps_done += O.iter
+                scene, parts = make_scene()
+                lid, tilt = start(scene, parts)
+            cell, plate_ids = parts["cell"], parts["plate_ids"]
             spilled = sum(s.get("spilled_particles_count", 0) for s in steps)
-            if k and lid.z() < parts["floor_z_m"] + 4.0 * scene.radius:
+            if k and not fresh and lid.z() < parts["floor_z_m"] + 4.0 * scene.radius:
                 raise RigFailure(f"step {k}: the lid is at z={lid.z():.4f} m, less than two particle diameters "
                                  f"above the sliding cell's bottom: the cell has lost its contents ({spilled} "
                                  "particles spilled in the slides of the previous steps); the test is not valid "
                                  "beyond this step")
             cons = consolidate(scene, lid, cell, plate_ids, stress, area, p, curve, k, parts["floor_z_m"],
                                parts["cell_bottom_z_m"])
-            res = tilt_test(scene, tilt, cell, lid, plate_ids, parts["spill_box_m"], p, record, k)
+            res = tilt_test(scene, tilt, cell, lid, plate_ids, parts["spill_box_m"], p, record, k,
+                            restore=not fresh)
             res.update(cons)
             res["wall_time_step_s"] = time.time() - w0
             res["stress_pa"] = stress
@@ -565,17 +598,17 @@ def run_friction_rig(scene, parts, out_dir):
     out.update({
         "n_particles": len(particle_ids),
         "n_particles_end": len(scene.sphere_ids),
+        "fill_each_step": p["fill_each_step"],
         "particle_mass_kg": mass_particles,
         "bulk_density_kg_m3": mass_particles / parts["contents_volume_m3"],
         "self_weight_stress_pa": weight / area,
-        "settle_time_s": parts["settle_time_s"],
+        "settle_time_s": settle_s,
         "timestep_s": O.dt,
-        "steps": O.iter,
+        "steps": steps_done + O.iter,
         "particle_damping_during_tilt": p["particle_damping_during_tilt"],
     })
-    cohesion_updates = getattr(scene.contact, "n_updates", None)
-    if cohesion_updates is not None:
-        out["cohesion_update_count"] = cohesion_updates
+    if getattr(scene.contact, "n_updates", None) is not None:
+        out["cohesion_update_count"] = cohesion_updates + scene.contact.n_updates
     # friction vs stress against the lab curve (CSV, PNG, misfit): pycal.post.friction
     try:
         from pycal.post import friction as post
