@@ -32,19 +32,27 @@ from .root1d import solve_monotone
 STAGE_KEYS = {
     "density": (["stage", "rig", "tolerance_percent"], ["max_iterations_count", "target"]),
     "rolling_resistance": (["stage", "rig", "response", "target", "parameter"],
-                           ["tolerance_deg", "max_iterations_count", "rig_overrides"]),
+                           ["tolerance_deg", "max_iterations_count", "rig_overrides", "set"]),
     "cohesion": (["stage", "rig", "response", "target", "parameter"],
-                 ["tolerance_deg", "max_iterations_count", "rig_overrides"]),
+                 ["tolerance_deg", "tolerance_mu", "max_iterations_count", "rig_overrides", "set"]),
     "stiffness": (["stage", "rig", "response", "target", "parameter"],
-                  ["tolerance_log_ratio", "max_iterations_count"]),
+                  ["tolerance_log_ratio", "max_iterations_count", "rig_overrides", "set"]),
+    "friction": (["stage", "rig", "response", "target", "parameter"],
+                 ["tolerance_mu", "max_iterations_count", "rig_overrides", "set"]),
     "inherit": (["stage", "from", "keys"], []),
 }
+# every stage may also have `name` (default: its stage type; `inherit` refers to it)
+# `set`: material keys given fixed values from this stage on (e.g. a cohesion model switched)
+TOLERANCE_KEYS = ("tolerance_log_ratio", "tolerance_mu", "tolerance_deg")   # the stage's tolerance, in response units
 
 
 def derived_responses():
     """Responses computed from a whole result (name -> function(result) -> float)."""
     from ..post.compression import unloading_stiffness_log_ratio
-    return {"unloading_stiffness_log_ratio": unloading_stiffness_log_ratio}
+    from ..post.friction import friction_offset
+    return {"unloading_stiffness_log_ratio": unloading_stiffness_log_ratio,
+            "friction_offset_mu_static": lambda r: friction_offset(r, "mu_static"),
+            "friction_offset_mu_dynamic": lambda r: friction_offset(r, "mu_dynamic")}
 
 
 def response_value(result, response):
@@ -68,12 +76,20 @@ def load_study(path):
         load_material(mat)
         if not isinstance(stages, list):
             c.fail(f"materials.{mat}", "must be a list of stages")
+        names = set()
         for i, st in enumerate(stages):
             key = f"materials.{mat}[{i}]"
             if not isinstance(st, dict) or st.get("stage") not in STAGE_KEYS:
                 c.fail(f"{key}.stage", f"must be one of {', '.join(STAGE_KEYS)}")
             req, opt = STAGE_KEYS[st["stage"]]
-            c.keys(st, key, req, opt)
+            c.keys(st, key, req, opt + ["name"])
+            label = stage_label(st)
+            if label in names:
+                c.fail(f"{key}.name", f"two stages of {mat} are called {label!r}: give them different names")
+            names.add(label)
+            for k in st.get("set", {}):
+                if str(k).startswith("rig."):
+                    c.fail(f"{key}.set.{k}", "only material keys may be set here (rig keys: rig_overrides)")
             if "target" in st:
                 t = st["target"]
                 if not isinstance(t, dict) or not ("value" in t or {"sample", "test"} <= set(t)):
@@ -88,6 +104,11 @@ def load_study(path):
                 if not lo <= p["start"] <= hi:
                     c.fail(f"{key}.parameter.start", f"{p['start']} outside bounds {p['bounds']}")
     return data
+
+
+def stage_label(st):
+    """The name of a stage in outputs and `inherit`: its `name`, else its stage type."""
+    return st.get("name", st["stage"])
 
 
 class Study:
@@ -152,7 +173,7 @@ class Study:
                           target_bulk_density_kg_m3=st.get("target", {}).get("value"))
         self.runs_requested += len(self.seeds) * fit.iterations
         for h in fit.history:
-            self.history.append({"material": material, "stage": "density", "rig": st["rig"],
+            self.history.append({"material": material, "stage": stage_label(st), "rig": st["rig"],
                                  "parameters": {DENSITY_KEY: h.particle_density_kg_m3},
                                  "response": "bulk_density_kg_m3", "mean": h.bulk_density_mean_kg_m3,
                                  "std": h.bulk_density_std_kg_m3, "n": h.n_seeds})
@@ -168,8 +189,9 @@ class Study:
         target. A stiffness spans decades: it is solved in log(E), values rounded to 3
         significant digits (so that reruns hit the job cache)."""
         p = st["parameter"]
+        self.overrides[material].update(st.get("set", {}))
         target = lab_target(st["target"])
-        tol = st["tolerance_log_ratio"] if "tolerance_log_ratio" in st else st.get("tolerance_deg", 2.0)
+        tol = next((st[k] for k in TOLERANCE_KEYS if k in st), 2.0)
         fixed = dict(st.get("rig_overrides", {}))   # e.g. a measured-equivalent faster lift
         log = st["stage"] == "stiffness"
         to_x = (lambda u: float(f"{math.exp(u):.3g}")) if log else (lambda u: u)
@@ -178,7 +200,7 @@ class Study:
         def evaluate(u):
             x = to_x(u)
             return self.evaluate(st["rig"], material, {**fixed, **{k: x for k in p["keys"]}},
-                                 st["response"], st["stage"], tolerance=tol)
+                                 st["response"], stage_label(st), tolerance=tol)
 
         sol = solve_monotone(evaluate, target, to_u(p["start"]), to_u(p["bounds"][0]), to_u(p["bounds"][1]),
                              tol, max_evaluations=st.get("max_iterations_count", 6),
@@ -195,7 +217,7 @@ class Study:
     def stage_inherit(self, material, st):
         src = st["from"]
         row = next((r for r in self.stage_rows
-                    if r["material"] == src["material"] and r["stage"] == src["stage"]), None)
+                    if r["material"] == src["material"] and r["stage"] == src["stage"]), None)   # stage = label
         if row is None:
             raise ConfigError(str(self.config_path), f"materials.{material}.from",
                               f"stage {src['stage']} of {src['material']} must run before")
@@ -214,13 +236,14 @@ class Study:
     def run(self):
         stage_fn = {"density": self.stage_density, "rolling_resistance": self.stage_monotone,
                     "cohesion": self.stage_monotone, "stiffness": self.stage_monotone,
+                    "friction": self.stage_monotone,
                     "inherit": self.stage_inherit}
         n_stages = sum(len(s) for s in self.cfg["materials"].values())
         k = 0
         for material, stages in self.cfg["materials"].items():
             for st in stages:
                 k += 1
-                self.log(f"[stage {k}/{n_stages}] {material}: {st['stage']}"
+                self.log(f"[stage {k}/{n_stages}] {material}: {stage_label(st)}"
                          + (f" on rig {st['rig']}" if "rig" in st else ""))
                 try:
                     row = stage_fn[st["stage"]](material, st)
@@ -231,7 +254,7 @@ class Study:
                            "response": st.get("response", ""), "response_mean": math.nan,
                            "response_std": math.nan, "target": math.nan, "tolerance": math.nan,
                            "met": False, "message": f"runs failed: {exc}", "evaluations": 0}
-                row.update({"material": material, "stage": st["stage"]})
+                row.update({"material": material, "stage": stage_label(st), "kind": st["stage"]})
                 self.stage_rows.append(row)
                 self.log(f"  -> {row['parameter']} = {row['value']:.4g}: "
                          + ("target met" if row["met"] else f"NOT met {row['message']}"))

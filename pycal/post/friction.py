@@ -144,6 +144,45 @@ def compare(summary, targets):
     return out
 
 
+# ------------------------------------------------------------------ calibration response
+
+STICKS_MU = 2.0   # a simulated step where the cell did not slide even at max tilt counts as
+                  # this friction coefficient (tan 63 deg: above every lab value here)
+
+
+def friction_offset(result, quantity="mu_static", min_stress_pa=10000.0, targets=None):
+    """Mean over the simulated steps at or above min_stress_pa of (simulated - lab)
+    `quantity`, the lab curve interpolated in log(stress) at the simulated stress; lab
+    steps where the cell sticks and simulated stresses outside the lab range are left
+    out; a simulated step that sticks counts as STICKS_MU. 0 = on the lab curve; rises
+    with the particle friction coefficient (the response of the calibration's friction
+    stages). Below ~10 kPa a loose bed shears inside itself first (measured), so those
+    steps say little about the contact friction.
+    targets: as load_targets (default: the lab curve of the rig and the material)."""
+    from .compression import interp_log_stress
+    if targets is None:
+        targets = load_targets(result["rig"], lab_sample_of(result))
+    t = targets.get(quantity)
+    if not t:
+        raise ValueError(f"{result.get('job_id', result.get('rig'))}: no lab curve of {quantity} to compare with")
+    slides = [i for i, o in enumerate(t["outcome"]) if o == "slides" and t["value"][i] is not None]
+    lab_s = [t["stress_pa"][i] for i in slides]
+    lab_v = [t["value"][i] for i in slides]
+    diffs = []
+    for k, s in enumerate(result["stress_pa"]):
+        if s < min_stress_pa:
+            continue
+        lab = interp_log_stress(lab_s, lab_v, s, extrapolate_ratio=0.0)
+        if lab is None:
+            continue
+        sim = STICKS_MU if result["sticks"][k] or result[quantity][k] is None else result[quantity][k]
+        diffs.append(sim - lab)
+    if not diffs:
+        raise ValueError(f"{result.get('job_id', result.get('rig'))}: no simulated step at or above "
+                         f"{min_stress_pa:g} Pa where the lab cell slides")
+    return sum(diffs) / len(diffs)
+
+
 # ------------------------------------------------------------------ outputs
 
 def write_summary_csv(summary, comparisons, path):

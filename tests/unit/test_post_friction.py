@@ -84,3 +84,32 @@ def test_mixed_rigs_rejected(tmp_path):
     with pytest.raises(ValueError):
         friction.write_outputs([result(1, [0.4] * 3, [0.4] * 3), result(2, [0.4] * 3, [0.4] * 3, rig="ccs")],
                                str(tmp_path))
+
+
+def test_friction_offset_is_mean_sim_minus_lab_above_the_low_stress_steps():
+    t = {"mu_static": friction.targets_from_arrays([3000, 12000, 40000, 86000], [0.40, 0.45, 0.50, 0.50],
+                                                   [0.35, 0.40, 0.45, 0.45], [0.45, 0.50, 0.55, 0.55])}
+    r = result(1, [0.10, 0.55, 0.52], [0.1, 0.5, 0.5], stress=(3000, 40000, 86000))
+    # 3 kPa is below min_stress_pa: (0.05 + 0.02) / 2
+    assert friction.friction_offset(r, "mu_static", targets=t) == pytest.approx(0.035)
+    # a stress between two lab steps: the lab value is interpolated in log stress
+    r2 = result(1, [0.5], [0.5], stress=(math.sqrt(12000 * 40000),))
+    assert friction.friction_offset(r2, "mu_static", targets=t) == pytest.approx(0.5 - 0.475)
+
+
+def test_friction_offset_counts_a_sticking_step_high_and_skips_lab_sticks():
+    t = {"mu_static": friction.targets_from_arrays([12000, 40000, 86000], [0.50, 0.60, float("nan")],
+                                                   [0.4, 0.5, float("nan")], [0.6, 0.7, float("nan")])}
+    r = result(1, [0.50, None, 0.9], [0.5, None, 0.9], sticks=[False, True, False], stress=(12000, 40000, 86000))
+    # 86 kPa: the lab sticks there -> left out; 40 kPa sticks in the simulation -> STICKS_MU
+    assert friction.friction_offset(r, "mu_static", targets=t) == pytest.approx((0.0 + friction.STICKS_MU - 0.6) / 2)
+    with pytest.raises(ValueError, match="no simulated step"):
+        friction.friction_offset(result(1, [0.4], [0.4], stress=(3000,)), "mu_static", targets=t)
+    with pytest.raises(ValueError, match="no lab curve"):
+        friction.friction_offset(r, "mu_dynamic", targets=t)
+
+
+def test_friction_offset_reads_the_lab_curve_of_the_material():
+    # gravel_dry wall friction: plateau 0.50 from 30 kPa (labresults/curves/wall_friction_gravel_dry.csv)
+    r = result(1, [0.51, 0.52], [0.5, 0.5], stress=(40000, 86000))
+    assert friction.friction_offset(r, "mu_static") == pytest.approx(0.015, abs=1e-6)

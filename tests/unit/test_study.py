@@ -185,3 +185,39 @@ def test_a_stage_whose_runs_fail_is_not_met_and_the_study_goes_on(tmp_path, stud
     assert "blow-up" in by[("M3-dry", "rolling_resistance")]["message"]
     assert not by[("M3-wet", "inherit")]["met"] and "was not met" in by[("M3-wet", "inherit")]["message"]
     assert ("M3-wet", "cohesion") in by          # the study went on
+
+
+def test_friction_stage_matches_the_wall_friction_curve(tmp_path):
+    """Fake wall friction: mu_static = 0.9 x particle-steel friction + 0.05 at every step
+    (a plateau). The lab gravel curve rises to 0.50 at 30 kPa; the offset response is the
+    mean (sim - lab) over the steps >= 10 kPa, so the stage must move the particle-steel
+    friction until that mean is within tolerance_mu, reading the lab curve itself."""
+    cfg = tmp_path / "fric.yaml"
+    cfg.write_text("""
+name: fric
+seeds_count: 2
+materials:
+  M2:
+    - stage: friction
+      rig: wall_friction
+      response: friction_offset_mu_static
+      target: {value: 0.0}
+      tolerance_mu: 0.01
+      parameter: {keys: [interactions.steel.friction_coefficient], start: 0.8, bounds: [0.05, 1.5], response_increases: true}
+""")
+    stress = [3000, 12000, 40000, 86000]
+
+    class Wall(FakeExecutor):
+        def run(self, jobs):
+            out = []
+            for j in jobs:
+                mu = 0.9 * j["materials"]["M2"]["interactions"]["steel"]["friction_coefficient"] + 0.05
+                out.append({"rig": "wall_friction", "material": "M2", "job": j, "stress_pa": stress,
+                            "mu_static": [mu] * 4, "mu_dynamic": [mu] * 4, "sticks": [False] * 4})
+            return out
+    (row,) = Study(cfg, Wall(), tmp_path / "out", log=lambda m: None).run()
+    lab = labdata.target_curve("wall_friction_gravel_dry", "mu_static")
+    at = {float(s): float(v) for s, v in zip(lab.stress_pa, lab.value)}
+    lab_mean = (at[12000] + at[40000] + at[86000]) / 3      # the simulated steps >= 10 kPa are lab steps
+    assert row["met"]
+    assert 0.9 * row["value"] + 0.05 == pytest.approx(lab_mean, abs=0.01)
