@@ -110,6 +110,13 @@ def write_report(study_dir, yade_version="unknown"):
         if img:
             parts.append(f"<img alt='{html.escape(s['material'] + ' ' + s['stage'])}' "
                          f"src='data:image/png;base64,{img}'>")
+    curves = [(s, f) for s in stages for f in s.get("plots") or [] if (study_dir / f).is_file()]
+    if curves:
+        parts.append("<h2>Lab curves vs simulation at the calibrated values</h2>")
+        for s, f in curves:
+            img = base64.b64encode((study_dir / f).read_bytes()).decode()
+            parts.append(f"<h4>{html.escape(s['material'] + ': ' + s['stage'])} ({html.escape(f)})</h4>"
+                         f"<img alt='{html.escape(f)}' style='max-width:100%' src='data:image/png;base64,{img}'>")
     parts.append("<h2>Provenance</h2><ul>"
                  f"<li>study config: <pre>{html.escape(json.dumps(cfg, indent=1))}</pre></li>"
                  f"<li>git commit: {html.escape(_git_commit())}</li>"

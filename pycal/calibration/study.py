@@ -125,6 +125,7 @@ class Study:
         self.overrides = {m: {} for m in self.cfg["materials"]}
         self.stage_rows, self.history = [], []
         self.runs_requested = 0
+        self.point_results = {}      # (material, stage label, parameters json) -> results of that point
         self.t0 = time.time()
 
     # ---------- evaluation ----------
@@ -144,14 +145,18 @@ class Study:
         tolerance, more seeds are added (up to max_seeds_count), so that a point is not
         judged "within tolerance" only because it is noisy."""
         overrides = {**self.overrides[material], **extra}
-        values = [response_value(r, response) for r in self._run_seeds(rig, material, overrides, self.seeds)]
+        results = list(self._run_seeds(rig, material, overrides, self.seeds))
+        values = [response_value(r, response) for r in results]
         m, s = mean_std(values)
         n_next = len(values)
         while tolerance is not None and n_next < self.max_seeds and 2 * s / math.sqrt(len(values)) > tolerance:
             more = list(range(n_next + 1, min(self.max_seeds, 2 * n_next) + 1))
             n_next = more[-1]
-            values += [response_value(r, response) for r in self._run_seeds(rig, material, overrides, more)]
+            new = list(self._run_seeds(rig, material, overrides, more))
+            results += new
+            values += [response_value(r, response) for r in new]
             m, s = mean_std(values)
+        self.point_results[(material, stage_name, json.dumps(extra, sort_keys=True))] = results
         self.history.append({"material": material, "stage": stage_name, "rig": rig,
                              "parameters": dict(extra), "response": response,
                              "mean": m, "std": s, "n": len(values)})
@@ -209,10 +214,35 @@ class Study:
         value = to_x(sol.x)
         for k in p["keys"]:
             self.overrides[material][k] = value
-        return {"parameter": "+".join(p["keys"]), "value": value, "response": st["response"],
+        chosen = {**fixed, **{k: value for k in p["keys"]}}
+        plots = self.stage_plots(material, stage_label(st), st["rig"],
+                                 self.point_results.get((material, stage_label(st), json.dumps(chosen, sort_keys=True))))
+        return {"plots": plots, "parameter": "+".join(p["keys"]), "value": value, "response": st["response"],
                 "response_mean": sol.point.mean, "response_std": sol.point.std, "target": target,
                 "tolerance": tol, "met": sol.met, "message": sol.message,
                 "evaluations": len(sol.history)}
+
+    def stage_plots(self, material, label, rig, results):
+        """Lab-vs-simulation curves of a stage's chosen point into plots/<material>-<label>/
+        (friction rigs: seeds pooled; compression rigs: the first seed); PNG paths
+        relative to the study folder. Plots never stop a study."""
+        if not results:
+            return []
+        out = self.out / "plots" / f"{material}-{label}"
+        try:
+            if rig in ("wall_friction", "internal_friction"):
+                from ..post import friction
+                files = friction.write_outputs(results, str(out))["files"]
+            elif rig in ("ccs", "ccs_expansion", "ucs"):
+                from ..post import compression
+                out.mkdir(parents=True, exist_ok=True)
+                files = compression.write_outputs(results[0], str(out))["files"]
+            else:
+                return []
+        except Exception as exc:     # noqa: BLE001 - a plot must not cost the calibration
+            self.log(f"  WARNING: plots of {material} {label} not written: {type(exc).__name__}: {exc}")
+            return []
+        return [str(Path(f).relative_to(self.out)) for f in files if str(f).endswith(".png")]
 
     def stage_inherit(self, material, st):
         src = st["from"]

@@ -215,7 +215,13 @@ materials:
                 out.append({"rig": "wall_friction", "material": "M2", "job": j, "stress_pa": stress,
                             "mu_static": [mu] * 4, "mu_dynamic": [mu] * 4, "sticks": [False] * 4})
             return out
-    (row,) = Study(cfg, Wall(), tmp_path / "out", log=lambda m: None).run()
+    study = Study(cfg, Wall(), tmp_path / "out", log=lambda m: None)
+    (row,) = study.run()
+    # the chosen point's friction curve against the lab band, pooled over seeds, in the report
+    assert row["plots"] == ["plots/M2-friction/friction_vs_stress.png"]
+    assert (tmp_path / "out" / "fric" / row["plots"][0]).stat().st_size > 1000
+    report = write_report(tmp_path / "out" / "fric").read_text()
+    assert "Lab curves vs simulation" in report and "friction_vs_stress.png" in report
     lab = labdata.target_curve("wall_friction_gravel_dry", "mu_static")
     at = {float(s): float(v) for s, v in zip(lab.stress_pa, lab.value)}
     lab_mean = (at[12000] + at[40000] + at[86000]) / 3      # the simulated steps >= 10 kPa are lab steps
