@@ -91,7 +91,8 @@ def write_report(study_dir, yade_version="unknown"):
              "<th>response</th><th>simulated (mean +/- std)</th><th>lab target</th><th>tolerance</th>"
              "<th>met</th><th>note</th></tr>"]
     for s in stages:
-        parts.append("<tr>" + "".join(f"<td>{_fmt(s.get(k, ''))}</td>" for k in
+        shown = dict(s, value="; ".join(f"{k} = {v:.4g}" for k, v in s["values"].items())) if s.get("values") else s
+        parts.append("<tr>" + "".join(f"<td>{_fmt(shown.get(k, ''))}</td>" for k in
                                       ("material", "stage", "parameter", "value", "response")) +
                      f"<td>{_fmt(s['response_mean'])} +/- {_fmt(s['response_std'])}</td>"
                      f"<td>{_fmt(s['target'])}</td><td>{_fmt(s['tolerance'])}</td>"

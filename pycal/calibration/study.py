@@ -39,6 +39,8 @@ STAGE_KEYS = {
                   ["tolerance_log_ratio", "max_iterations_count", "rig_overrides", "set"]),
     "friction": (["stage", "rig", "response", "target", "parameter"],
                  ["tolerance_mu", "max_iterations_count", "rig_overrides", "set"]),
+    "joint": (["stage", "rig", "response", "parameters", "tolerance_rms_z"],
+              ["max_iterations_count", "rig_overrides", "set"]),
     "inherit": (["stage", "from", "keys"], []),
 }
 # every stage may also have `name` (default: its stage type; `inherit` refers to it)
@@ -53,6 +55,13 @@ def derived_responses():
     return {"unloading_stiffness_log_ratio": unloading_stiffness_log_ratio,
             "friction_offset_mu_static": lambda r: friction_offset(r, "mu_static"),
             "friction_offset_mu_dynamic": lambda r: friction_offset(r, "mu_dynamic")}
+
+
+def vector_responses():
+    """Residual vectors computed from a whole result (name -> function(result) -> list)."""
+    from ..post.friction import friction_band_z
+    return {"friction_band_z_mu_static": lambda r: friction_band_z(r, "mu_static"),
+            "friction_band_z_mu_dynamic": lambda r: friction_band_z(r, "mu_dynamic")}
 
 
 def response_value(result, response):
@@ -103,6 +112,16 @@ def load_study(path):
                 lo, hi = p["bounds"]
                 if not lo <= p["start"] <= hi:
                     c.fail(f"{key}.parameter.start", f"{p['start']} outside bounds {p['bounds']}")
+            if st["stage"] == "joint":
+                if st["response"] not in vector_responses():
+                    c.fail(f"{key}.response", f"must be one of {', '.join(vector_responses())}")
+                if not isinstance(st["parameters"], list) or len(st["parameters"]) < 2:
+                    c.fail(f"{key}.parameters", "a joint stage moves a list of at least two parameter groups")
+                for j, p in enumerate(st["parameters"]):
+                    c.keys(p, f"{key}.parameters[{j}]", ["keys", "bounds"], ["start"])
+                    lo, hi = p["bounds"]
+                    if not lo < hi or ("start" in p and not lo <= p["start"] <= hi):
+                        c.fail(f"{key}.parameters[{j}]", f"start {p.get('start')} / bounds {p['bounds']} invalid")
     return data
 
 
@@ -244,6 +263,69 @@ class Study:
             return []
         return [str(Path(f).relative_to(self.out)) for f in files if str(f).endswith(".png")]
 
+    def evaluate_vector(self, rig, material, extra, response, stage_name):
+        """Residual vector of `response` averaged over the seeds, element by element (a
+        step no seed reached stays None); the history gets its RMS."""
+        from .joint import rms
+        overrides = {**self.overrides[material], **extra}
+        results = list(self._run_seeds(rig, material, overrides, self.seeds))
+        vectors = [vector_responses()[response](r) for r in results]
+        mean = []
+        for k in range(max(len(v) for v in vectors)):
+            vals = [v[k] for v in vectors if k < len(v) and v[k] is not None]
+            mean.append(sum(vals) / len(vals) if vals else None)
+        per_seed = [rms(v) for v in vectors]
+        self.point_results[(material, stage_name, json.dumps(extra, sort_keys=True))] = results
+        self.history.append({"material": material, "stage": stage_name, "rig": rig, "parameters": dict(extra),
+                             "response": f"RMS {response}", "mean": rms(mean),
+                             "std": mean_std(per_seed)[1], "n": len(results)})
+        self.log(f"  {material} {stage_name}: {extra} -> RMS {response} = {rms(mean):.3g} "
+                 f"(z {['-' if z is None else round(z, 2) for z in mean]}; runs requested {self.runs_requested}, "
+                 f"elapsed {time.time() - self.t0:.0f} s)")
+        return mean
+
+    def current_value(self, material, key):
+        """The value a material key has at this point of the study (calibrated or config)."""
+        if key in self.overrides[material]:
+            return self.overrides[material][key]
+        node = load_material(material)
+        for part in key.split("."):
+            node = node[part]
+        return node
+
+    def stage_joint(self, material, st):
+        """Several coupled parameter groups fitted together to the band z of a lab curve
+        (pycal.calibration.joint: scipy least squares). A parameter without `start`
+        starts from its current value (e.g. one inherited from another material)."""
+        from .joint import solve_joint
+        self.overrides[material].update(st.get("set", {}))
+        fixed = dict(st.get("rig_overrides", {}))
+        params = st["parameters"]
+        label = stage_label(st)
+
+        def extra_of(xs):
+            e = dict(fixed)
+            for p, x in zip(params, xs):
+                for k in p["keys"]:
+                    e[k] = x
+            return e
+
+        x0 = [p["start"] if "start" in p else self.current_value(material, p["keys"][0]) for p in params]
+        x0 = [min(p["bounds"][1], max(p["bounds"][0], x)) for p, x in zip(params, x0)]
+        sol = solve_joint(lambda xs: self.evaluate_vector(st["rig"], material, extra_of(xs), st["response"], label),
+                          x0, [p["bounds"][0] for p in params], [p["bounds"][1] for p in params],
+                          st["tolerance_rms_z"], max_evaluations=st.get("max_iterations_count", 10))
+        for p, x in zip(params, sol.x):
+            for k in p["keys"]:
+                self.overrides[material][k] = x
+        plots = self.stage_plots(material, label, st["rig"],
+                                 self.point_results.get((material, label, json.dumps(extra_of(sol.x), sort_keys=True))))
+        return {"plots": plots, "parameter": " ; ".join("+".join(p["keys"]) for p in params), "value": sol.x[0],
+                "values": {"+".join(p["keys"]): x for p, x in zip(params, sol.x)},
+                "response": f"RMS {st['response']}", "response_mean": sol.rms, "response_std": math.nan,
+                "target": 0.0, "tolerance": st["tolerance_rms_z"], "met": sol.met, "message": sol.message,
+                "evaluations": len(sol.history)}
+
     def stage_inherit(self, material, st):
         src = st["from"]
         row = next((r for r in self.stage_rows
@@ -266,7 +348,7 @@ class Study:
     def run(self):
         stage_fn = {"density": self.stage_density, "rolling_resistance": self.stage_monotone,
                     "cohesion": self.stage_monotone, "stiffness": self.stage_monotone,
-                    "friction": self.stage_monotone,
+                    "friction": self.stage_monotone, "joint": self.stage_joint,
                     "inherit": self.stage_inherit}
         n_stages = sum(len(s) for s in self.cfg["materials"].values())
         k = 0
@@ -286,7 +368,8 @@ class Study:
                            "met": False, "message": f"runs failed: {exc}", "evaluations": 0}
                 row.update({"material": material, "stage": stage_label(st), "kind": st["stage"]})
                 self.stage_rows.append(row)
-                self.log(f"  -> {row['parameter']} = {row['value']:.4g}: "
+                shown = row.get("values") or {row["parameter"]: row["value"]}
+                self.log(f"  -> {', '.join(f'{k} = {v:.4g}' for k, v in shown.items())}: "
                          + ("target met" if row["met"] else f"NOT met {row['message']}"))
                 self.write_outputs()
         return self.stage_rows

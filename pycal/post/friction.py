@@ -183,6 +183,28 @@ def friction_offset(result, quantity="mu_static", min_stress_pa=10000.0, targets
     return sum(diffs) / len(diffs)
 
 
+def friction_band_z(result, quantity="mu_static", min_stress_pa=10000.0, targets=None):
+    """Per lab step at or above min_stress_pa where the lab cell slides: z = (simulated -
+    lab) / (half band width on the side of the simulation), the simulated curve
+    interpolated in log(stress) (None where it does not reach that step; a simulated
+    step that sticks counts as STICKS_MU). |z| <= 1 is inside the band: the residual
+    vector of the calibration's joint stages."""
+    from .compression import interp_log_stress, band_z
+    if targets is None:
+        targets = load_targets(result["rig"], lab_sample_of(result))
+    t = targets.get(quantity)
+    if not t:
+        raise ValueError(f"{result.get('job_id', result.get('rig'))}: no lab curve of {quantity} to compare with")
+    sim = [STICKS_MU if st or v is None else v for st, v in zip(result["sticks"], result[quantity])]
+    out = []
+    for i, s in enumerate(t["stress_pa"]):
+        if s < min_stress_pa or t["outcome"][i] != "slides" or t["value"][i] is None:
+            continue
+        v = interp_log_stress(result["stress_pa"], sim, s)
+        out.append(None if v is None else band_z(v, t["value"][i], t["low"][i], t["high"][i]))
+    return out
+
+
 # ------------------------------------------------------------------ outputs
 
 def write_summary_csv(summary, comparisons, path):

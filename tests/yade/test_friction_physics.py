@@ -215,3 +215,39 @@ def test_liquid_bridge_holds_when_stronger_than_weight(tmp_path_factory):
     res = json.loads(out.read_text())
     assert res["strong"] < 0.002
     assert res["weak"] > 0.005
+
+
+# ---------------------------------------------------------------- internal friction
+
+FRICTIONLESS = {"interactions.M2.friction_coefficient": 0.0, "interactions.pvc.friction_coefficient": 0.0,
+                "interactions.M2.rolling_resistance_coefficient": 0.0,
+                "interactions.steel.rolling_resistance_coefficient": 0.0,
+                "interactions.pvc.rolling_resistance_coefficient": 0.0}
+INTERNAL_SHORT = {"rig.procedure.max_tilt_deg": 50.0}   # a cell that has not travelled by 50 deg sticks
+
+
+def internal(tmp_path_factory, name, overrides, stresses):
+    if name not in _RUNS:
+        o = dict(INTERNAL_SHORT, **overrides)
+        o["rig.procedure.consolidation_stresses_pa"] = stresses
+        job = resolve_job("internal_friction", "M2", o, seed=SEED)
+        _RUNS[name] = run_job(job, runs_dir=tmp_path_factory.mktemp(name), timeout_s=900)
+    return _RUNS[name]
+
+
+def test_internal_friction_fresh_fill_per_step_repeats_bit_for_bit(tmp_path_factory):
+    """fill_each_step: fresh - the same seed gives the same fill, so two steps at the same
+    stress are the same simulation."""
+    r = internal(tmp_path_factory, "internal_start", {}, [3000, 3000])
+    assert r["fill_each_step"] == "fresh"
+    assert r["mu_static"][0] == r["mu_static"][1]
+    assert r["onset_angle_deg"][0] == r["onset_angle_deg"][1]
+
+
+def test_internal_friction_of_frictionless_spheres_is_low_and_rises_with_contact_friction(tmp_path_factory):
+    """Frictionless, non-rolling spheres shear at a low angle (only the packing's
+    geometry resists); the start values (particle friction 0.6, rolling 0.35) much later."""
+    smooth = internal(tmp_path_factory, "internal_smooth", FRICTIONLESS, [3000])
+    rough = internal(tmp_path_factory, "internal_start", {}, [3000, 3000])
+    assert smooth["mu_static"][0] < SMOOTH_MAX
+    assert rough["mu_static"][0] > smooth["mu_static"][0] + 0.15
