@@ -31,6 +31,10 @@ BENCHES = {
     "aor": ("aor", "M2", {}, 1),            # needs yade_scripts/aor.py
     # mixed -50 mm sample (M1 clumps + M2 + M3-dry), lift at 10 mm/s as in the measurements of issue 7
     "aor_mixed": ("aor_mixed", "mixed-dry", {"rig.procedure.lift_speed_m_s": 0.01}, 1),
+    "ccs": ("ccs", "M2", {}, 1),                                     # 7 load steps, start values
+    "ucs": ("ucs", "M2", {"rig.procedure.lift_speed_m_s": 0.01}, 1),  # stops at the overlap limit at E 6e6
+    "wall_friction": ("wall_friction", "M2", {}, 1),                 # one full friction curve, 7 steps
+    "internal_friction": ("internal_friction", "M2", {}, 1),         # 7 steps, a fresh fill each (~8 min)
 }
 
 RESULTS = Path(__file__).resolve().parent / "results.jsonl"
@@ -56,7 +60,7 @@ def run_bench(name, runs=3):
             wall = time.perf_counter() - t0
         finally:
             shutil.rmtree(d, ignore_errors=True)
-        steps = int(res.get("steps", 0))
+        steps = int(res.get("steps") or sum(res.get("step_steps_count") or [0]))   # compression: load steps only
         n = int(res.get("n_particles", 0))
         yade_wall = res.get("provenance", {}).get("wall_time_s")
         samples.append({"wall_s": wall, "yade_wall_s": yade_wall, "steps": steps, "n_particles": n})
@@ -110,7 +114,7 @@ def main(argv=None):
         for r in rows:
             print(f"{r['bench']:8} {r['runs']:>4} {r['wall_s_median']:>16.2f} "
                   f"{r['wall_s_min']:>6.2f}-{r['wall_s_max']:<6.2f} {r['steps']:>8.0f} {r['n_particles_final']:>9.0f} "
-                  f"{r['particle_steps_per_s']:>16.0f} {r['ms_per_step']:>8.3f}")
+                  f"{r['particle_steps_per_s'] or 0:>16.0f} {r['ms_per_step'] or 0:>8.3f}")
         print(f"appended {len(rows)} line(s) to {RESULTS.relative_to(ROOT)}")
     return 1 if failed else 0
 

@@ -4,7 +4,7 @@ Files: samples.yaml, the tables size_distribution.csv, angle_of_repose.csv,
 surcharge.csv, boundaries.csv, shapes.csv, shape_shares.csv, and the target curves
 curves/<name>.csv. Every numeric column carries its unit in its name (``_pa``,
 ``_kg_m3``, ``_deg``, ``_percent``...; ``mu_*`` = friction coefficient, no unit) and
-every row a ``provenance`` (measured / reconstructed). Errors name the file relative
+every row a ``provenance`` (measured / reconstructed / synthetic: simulated by a twin). Errors name the file relative
 to the repo and the column: ``labresults/curves/x.csv: stress_pa: row 3: ...``.
 CSV lines starting with ``#`` are comments.
 """
@@ -19,7 +19,7 @@ from . import CONFIG_DIR, LAB_DIR
 from .configs import DIMENSIONLESS_SUFFIXES, UNIT_SUFFIXES, _Checker, load_yaml
 from .errors import ConfigError
 
-PROVENANCES = ("measured", "reconstructed")
+PROVENANCES = ("measured", "reconstructed", "synthetic")   # synthetic: simulated with known parameters (a twin)
 OUTCOMES = ("slides", "sticks")   # curves: `sticks` = the cell does not slide up to the max tilt
 LAB_UNIT_SUFFIXES = UNIT_SUFFIXES + DIMENSIONLESS_SUFFIXES + ("_exponent", "_t_h", "_kg_m")
 DIMENSIONLESS_PREFIXES = ("mu_",)  # friction coefficients

@@ -48,24 +48,34 @@ STAGE_KEYS = {
 TOLERANCE_KEYS = ("tolerance_log_ratio", "tolerance_mu", "tolerance_deg")   # the stage's tolerance, in response units
 
 
-def derived_responses():
-    """Responses computed from a whole result (name -> function(result) -> float)."""
+def _friction_targets(result, lab_dir):
+    from ..post import friction
+    return friction.load_targets(result["rig"], friction.lab_sample_of(result), lab_dir)
+
+
+def derived_responses(lab_dir=None):
+    """Responses computed from a whole result against the lab curves of lab_dir (default
+    labresults/): name -> function(result) -> float."""
     from ..post.compression import unloading_stiffness_log_ratio
     from ..post.friction import friction_offset
-    return {"unloading_stiffness_log_ratio": unloading_stiffness_log_ratio,
-            "friction_offset_mu_static": lambda r: friction_offset(r, "mu_static"),
-            "friction_offset_mu_dynamic": lambda r: friction_offset(r, "mu_dynamic")}
+    return {"unloading_stiffness_log_ratio": lambda r: unloading_stiffness_log_ratio(r, lab_dir=lab_dir),
+            "friction_offset_mu_static":
+                lambda r: friction_offset(r, "mu_static", targets=_friction_targets(r, lab_dir)),
+            "friction_offset_mu_dynamic":
+                lambda r: friction_offset(r, "mu_dynamic", targets=_friction_targets(r, lab_dir))}
 
 
-def vector_responses():
+def vector_responses(lab_dir=None):
     """Residual vectors computed from a whole result (name -> function(result) -> list)."""
     from ..post.friction import friction_band_z
-    return {"friction_band_z_mu_static": lambda r: friction_band_z(r, "mu_static"),
-            "friction_band_z_mu_dynamic": lambda r: friction_band_z(r, "mu_dynamic")}
+    return {"friction_band_z_mu_static":
+                lambda r: friction_band_z(r, "mu_static", targets=_friction_targets(r, lab_dir)),
+            "friction_band_z_mu_dynamic":
+                lambda r: friction_band_z(r, "mu_dynamic", targets=_friction_targets(r, lab_dir))}
 
 
-def response_value(result, response):
-    derived = derived_responses()
+def response_value(result, response, lab_dir=None):
+    derived = derived_responses(lab_dir)
     return float(derived[response](result)) if response in derived else float(result[response])
 
 
@@ -91,7 +101,7 @@ def load_study(path):
             if not isinstance(st, dict) or st.get("stage") not in STAGE_KEYS:
                 c.fail(f"{key}.stage", f"must be one of {', '.join(STAGE_KEYS)}")
             req, opt = STAGE_KEYS[st["stage"]]
-            c.keys(st, key, req, opt + ["name"])
+            c.keys(st, key, req, opt + (["name"] if st["stage"] == "inherit" else ["name", "lab_dir"]))
             label = stage_label(st)
             if label in names:
                 c.fail(f"{key}.name", f"two stages of {mat} are called {label!r}: give them different names")
@@ -157,7 +167,7 @@ class Study:
                               f"run budget of {budget} spent; raise it to continue")
         return self.executor.run(jobs)
 
-    def evaluate(self, rig, material, extra, response, stage_name, tolerance=None):
+    def evaluate(self, rig, material, extra, response, stage_name, tolerance=None, lab_dir=None):
         """(mean, std, n) of `response` over the seeds with the current overrides + extra.
 
         Noise-aware: while the standard error 2 std / sqrt(n) is larger than the
@@ -165,7 +175,7 @@ class Study:
         judged "within tolerance" only because it is noisy."""
         overrides = {**self.overrides[material], **extra}
         results = list(self._run_seeds(rig, material, overrides, self.seeds))
-        values = [response_value(r, response) for r in results]
+        values = [response_value(r, response, lab_dir) for r in results]
         m, s = mean_std(values)
         n_next = len(values)
         while tolerance is not None and n_next < self.max_seeds and 2 * s / math.sqrt(len(values)) > tolerance:
@@ -173,7 +183,7 @@ class Study:
             n_next = more[-1]
             new = list(self._run_seeds(rig, material, overrides, more))
             results += new
-            values += [response_value(r, response) for r in new]
+            values += [response_value(r, response, lab_dir) for r in new]
             m, s = mean_std(values)
         self.point_results[(material, stage_name, json.dumps(extra, sort_keys=True))] = results
         self.history.append({"material": material, "stage": stage_name, "rig": rig,
@@ -224,7 +234,7 @@ class Study:
         def evaluate(u):
             x = to_x(u)
             return self.evaluate(st["rig"], material, {**fixed, **{k: x for k in p["keys"]}},
-                                 st["response"], stage_label(st), tolerance=tol)
+                                 st["response"], stage_label(st), tolerance=tol, lab_dir=self.lab_dir(st))
 
         sol = solve_monotone(evaluate, target, to_u(p["start"]), to_u(p["bounds"][0]), to_u(p["bounds"][1]),
                              tol, max_evaluations=st.get("max_iterations_count", 6),
@@ -235,13 +245,14 @@ class Study:
             self.overrides[material][k] = value
         chosen = {**fixed, **{k: value for k in p["keys"]}}
         plots = self.stage_plots(material, stage_label(st), st["rig"],
-                                 self.point_results.get((material, stage_label(st), json.dumps(chosen, sort_keys=True))))
+                                 self.point_results.get((material, stage_label(st), json.dumps(chosen, sort_keys=True))),
+                                 self.lab_dir(st))
         return {"plots": plots, "parameter": "+".join(p["keys"]), "value": value, "response": st["response"],
                 "response_mean": sol.point.mean, "response_std": sol.point.std, "target": target,
                 "tolerance": tol, "met": sol.met, "message": sol.message,
                 "evaluations": len(sol.history)}
 
-    def stage_plots(self, material, label, rig, results):
+    def stage_plots(self, material, label, rig, results, lab_dir=None):
         """Lab-vs-simulation curves of a stage's chosen point into plots/<material>-<label>/
         (friction rigs: seeds pooled; compression rigs: the first seed); PNG paths
         relative to the study folder. Plots never stop a study."""
@@ -251,11 +262,11 @@ class Study:
         try:
             if rig in ("wall_friction", "internal_friction"):
                 from ..post import friction
-                files = friction.write_outputs(results, str(out))["files"]
+                files = friction.write_outputs(results, str(out), lab_dir=lab_dir)["files"]
             elif rig in ("ccs", "ccs_expansion", "ucs"):
                 from ..post import compression
                 out.mkdir(parents=True, exist_ok=True)
-                files = compression.write_outputs(results[0], str(out))["files"]
+                files = compression.write_outputs(results[0], str(out), lab_dir=lab_dir)["files"]
             else:
                 return []
         except Exception as exc:     # noqa: BLE001 - a plot must not cost the calibration
@@ -263,13 +274,13 @@ class Study:
             return []
         return [str(Path(f).relative_to(self.out)) for f in files if str(f).endswith(".png")]
 
-    def evaluate_vector(self, rig, material, extra, response, stage_name):
+    def evaluate_vector(self, rig, material, extra, response, stage_name, lab_dir=None):
         """Residual vector of `response` averaged over the seeds, element by element (a
         step no seed reached stays None); the history gets its RMS."""
         from .joint import rms
         overrides = {**self.overrides[material], **extra}
         results = list(self._run_seeds(rig, material, overrides, self.seeds))
-        vectors = [vector_responses()[response](r) for r in results]
+        vectors = [vector_responses(lab_dir)[response](r) for r in results]
         mean = []
         for k in range(max(len(v) for v in vectors)):
             vals = [v[k] for v in vectors if k < len(v) and v[k] is not None]
@@ -283,6 +294,11 @@ class Study:
                  f"(z {['-' if z is None else round(z, 2) for z in mean]}; runs requested {self.runs_requested}, "
                  f"elapsed {time.time() - self.t0:.0f} s)")
         return mean
+
+    def lab_dir(self, st):
+        """The stage's lab data folder (`lab_dir`, relative to the study config; laid out as
+        labresults/, e.g. a synthetic twin's curves), else None = labresults/."""
+        return (self.config_path.parent / st["lab_dir"]) if "lab_dir" in st else None
 
     def current_value(self, material, key):
         """The value a material key has at this point of the study (calibrated or config)."""
@@ -312,14 +328,16 @@ class Study:
 
         x0 = [p["start"] if "start" in p else self.current_value(material, p["keys"][0]) for p in params]
         x0 = [min(p["bounds"][1], max(p["bounds"][0], x)) for p, x in zip(params, x0)]
-        sol = solve_joint(lambda xs: self.evaluate_vector(st["rig"], material, extra_of(xs), st["response"], label),
+        sol = solve_joint(lambda xs: self.evaluate_vector(st["rig"], material, extra_of(xs), st["response"], label,
+                                                          self.lab_dir(st)),
                           x0, [p["bounds"][0] for p in params], [p["bounds"][1] for p in params],
                           st["tolerance_rms_z"], max_evaluations=st.get("max_iterations_count", 10))
         for p, x in zip(params, sol.x):
             for k in p["keys"]:
                 self.overrides[material][k] = x
         plots = self.stage_plots(material, label, st["rig"],
-                                 self.point_results.get((material, label, json.dumps(extra_of(sol.x), sort_keys=True))))
+                                 self.point_results.get((material, label, json.dumps(extra_of(sol.x), sort_keys=True))),
+                                 self.lab_dir(st))
         return {"plots": plots, "parameter": " ; ".join("+".join(p["keys"]) for p in params), "value": sol.x[0],
                 "values": {"+".join(p["keys"]): x for p, x in zip(params, sol.x)},
                 "response": f"RMS {st['response']}", "response_mean": sol.rms, "response_std": math.nan,

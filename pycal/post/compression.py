@@ -413,11 +413,11 @@ if __name__ == "__main__":
     sys.exit(main())
 
 
-def unloading_stiffness_log_ratio(result, min_stress_pa=10000.0):
+def unloading_stiffness_log_ratio(result, min_stress_pa=10000.0, lab_dir=None):
     """log of the geometric mean of simulated / lab unloading stiffness over the lab's
     unloading steps at or above min_stress_pa (below it particles lose contact and the
     lab curve drops). 0 = on the lab curve; a calibration response that rises with E."""
-    targets = load_targets(result["rig"], lab_sample_of(result))
+    targets = load_targets(result["rig"], lab_sample_of(result), lab_dir)
     comp = compare(derived_arrays(dict(result)), targets).get("unloading_stiffness")
     if comp is None:
         raise ValueError(f"{result.get('job_id')}: no unloading stiffness to compare with a lab curve")

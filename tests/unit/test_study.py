@@ -227,3 +227,36 @@ materials:
     lab_mean = (at[12000] + at[40000] + at[86000]) / 3      # the simulated steps >= 10 kPa are lab steps
     assert row["met"]
     assert 0.9 * row["value"] + 0.05 == pytest.approx(lab_mean, abs=0.01)
+
+
+def test_a_stage_can_read_its_lab_curves_from_another_folder(tmp_path):
+    """lab_dir (relative to the study file) holds curves laid out as labresults/: a
+    synthetic twin's targets. Fake wall friction mu = 0.9 x particle-steel friction + 0.05
+    against a flat synthetic curve of 0.32 -> particle-steel friction 0.30."""
+    (tmp_path / "twin_lab" / "curves").mkdir(parents=True)
+    rows = "\n".join(f"{s},0.320,0.300,0.340,0.320,0.300,0.340,synthetic" for s in (12000, 40000, 86000))
+    (tmp_path / "twin_lab" / "curves" / "wall_friction_gravel_dry.csv").write_text(
+        "# synthetic twin\nstress_pa,mu_static,mu_static_low,mu_static_high,mu_dynamic,mu_dynamic_low,"
+        "mu_dynamic_high,provenance\n" + rows + "\n")
+    cfg = tmp_path / "fric.yaml"
+    cfg.write_text("""
+name: fric
+seeds_count: 1
+materials:
+  M2:
+    - stage: friction
+      rig: wall_friction
+      lab_dir: twin_lab
+      response: friction_offset_mu_static
+      target: {value: 0.0}
+      tolerance_mu: 0.005
+      parameter: {keys: [interactions.steel.friction_coefficient], start: 0.5, bounds: [0.05, 1.5], response_increases: true}
+""")
+
+    class Wall(FakeExecutor):
+        def run(self, jobs):
+            mu = [0.9 * j["materials"]["M2"]["interactions"]["steel"]["friction_coefficient"] + 0.05 for j in jobs]
+            return [{"rig": "wall_friction", "material": "M2", "job": j, "stress_pa": [12000, 40000, 86000],
+                     "mu_static": [m] * 3, "mu_dynamic": [m] * 3, "sticks": [False] * 3} for j, m in zip(jobs, mu)]
+    (row,) = Study(cfg, Wall(), tmp_path / "out", log=lambda m: None).run()
+    assert row["met"] and row["value"] == pytest.approx(0.30, abs=0.006)
