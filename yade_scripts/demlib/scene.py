@@ -109,12 +109,15 @@ class Scene:
         return dt
 
     def kinetic_energy_ratio(self):
-        """Kinetic energy of the particles / (their weight x one diameter) (-)."""
+        """Kinetic energy of the particles / (their weight x one diameter) (-); of
+        translation only if the rig's numerics say rest_kinetic_energy: translational
+        (pycal.configs.OPTIONAL_NUMERICS; without the key: translation and rotation)."""
         spheres = self.live_spheres()
         if not spheres:
             return 0.0
+        rotation = self.num.get("rest_kinetic_energy", "total") == "total"
         ke = sum(0.5 * b.state.mass * b.state.vel.squaredNorm()
-                 + 0.5 * sum(b.state.inertia[k] * b.state.angVel[k] ** 2 for k in range(3))
+                 + (0.5 * sum(b.state.inertia[k] * b.state.angVel[k] ** 2 for k in range(3)) if rotation else 0.0)
                  for b in spheres)
         ref = sum(b.state.mass for b in spheres) * self.g * 2.0 * self.radius
         return ke / ref
