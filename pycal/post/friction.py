@@ -28,6 +28,17 @@ from . import mean_std
 from .compression import misfit, EXTRAPOLATE_RATIO
 
 QUANTITIES = ("mu_static", "mu_dynamic")
+# mu_dynamic = tan t - a / (g cos t) loses mu as cos t -> 0 (at 90 deg a = g whatever mu is):
+# a travel timed at a held angle above this gives no dynamic friction (the rig reports
+# mu_dynamic None there, and older results are read the same way)
+DYNAMIC_MAX_ANGLE_DEG = 85.0
+
+
+def dynamic_value(result, k):
+    """mu_dynamic of step k, None where the travel was timed above DYNAMIC_MAX_ANGLE_DEG."""
+    a = (result.get("dynamic_angle_deg") or [None] * (k + 1))[k]
+    v = result["mu_dynamic"][k]
+    return None if v is None or (a is not None and a > DYNAMIC_MAX_ANGLE_DEG) else v
 RIGS = ("wall_friction", "internal_friction")
 
 
@@ -50,8 +61,11 @@ def seed_summary(results):
         rows = []
         for r in results:
             if s in r["stress_pa"]:
-                rows.append({k: r[k][r["stress_pa"].index(s)] for k in QUANTITIES + ("sticks", "max_tilt_deg")
-                             if k in r})
+                i = r["stress_pa"].index(s)
+                row = {k: r[k][i] for k in QUANTITIES + ("sticks", "max_tilt_deg") if k in r}
+                if "mu_dynamic" in r:
+                    row["mu_dynamic"] = dynamic_value(r, i)
+                rows.append(row)
         out["n_seeds"].append(len(rows))
         out["sticks_ratio"].append(sum(1 for x in rows if x.get("sticks")) / len(rows))
         tilts = [x["max_tilt_deg"] for x in rows if x.get("max_tilt_deg") is not None]
@@ -175,7 +189,8 @@ def friction_offset(result, quantity="mu_static", min_stress_pa=10000.0, targets
         lab = interp_log_stress(lab_s, lab_v, s, extrapolate_ratio=0.0)
         if lab is None:
             continue
-        sim = STICKS_MU if result["sticks"][k] or result[quantity][k] is None else result[quantity][k]
+        v = dynamic_value(result, k) if quantity == "mu_dynamic" else result[quantity][k]
+        sim = STICKS_MU if result["sticks"][k] or v is None else v
         diffs.append(sim - lab)
     if not diffs:
         raise ValueError(f"{result.get('job_id', result.get('rig'))}: no simulated step at or above "
@@ -195,7 +210,9 @@ def friction_band_z(result, quantity="mu_static", min_stress_pa=10000.0, targets
     t = targets.get(quantity)
     if not t:
         raise ValueError(f"{result.get('job_id', result.get('rig'))}: no lab curve of {quantity} to compare with")
-    sim = [STICKS_MU if st or v is None else v for st, v in zip(result["sticks"], result[quantity])]
+    vals = ([dynamic_value(result, k) for k in range(len(result["stress_pa"]))] if quantity == "mu_dynamic"
+            else result[quantity])
+    sim = [STICKS_MU if st or v is None else v for st, v in zip(result["sticks"], vals)]
     out = []
     for i, s in enumerate(t["stress_pa"]):
         if s < min_stress_pa or t["outcome"][i] != "slides" or t["value"][i] is None:

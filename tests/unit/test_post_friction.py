@@ -113,3 +113,13 @@ def test_friction_offset_reads_the_lab_curve_of_the_material():
     # gravel_dry wall friction: plateau 0.50 from 30 kPa (labresults/curves/wall_friction_gravel_dry.csv)
     r = result(1, [0.51, 0.52], [0.5, 0.5], stress=(40000, 86000))
     assert friction.friction_offset(r, "mu_static") == pytest.approx(0.015, abs=1e-6)
+
+
+def test_dynamic_friction_timed_near_vertical_is_not_a_value():
+    """At a held angle near 90 deg a = g (sin t - mu cos t) loses mu: tan t / cos t blow up
+    (a real internal-friction run read 1.6e16). Such steps give no mu_dynamic."""
+    r = result(1, [0.5, 0.6], [0.45, 1.6e16], stress=(12000, 40000))
+    r["dynamic_angle_deg"] = [26.0, 90.0]
+    s = friction.seed_summary([r])
+    assert s["mu_dynamic_mean"] == [0.45, None] and s["mu_dynamic_n"] == [1, 0]
+    assert friction.dynamic_value(r, 1) is None and friction.dynamic_value(r, 0) == 0.45

@@ -32,6 +32,7 @@ if _REPO not in sys.path:
     sys.path.insert(0, _REPO)
 
 DAMPING_MODES = ("damped", "undamped", "undamped_when_sliding")
+from pycal.post.friction import DYNAMIC_MAX_ANGLE_DEG  # noqa: E402  (pure Python, one rule for rig and post)
 
 
 # ------------------------------------------------------------------ geometry
@@ -305,7 +306,9 @@ def tilt_test(scene, tilt, cell, lid, plate_ids, spill_box, proc, record, step_i
     and the hold is repeated there (dynamic_restarts_count; between holds the table tilts at
     tilt_restart_rate_deg_s: the static reading is done, and mu_dynamic comes from the
     acceleration at the held angle, not from how fast it was reached); if max_tilt_deg is reached
-    before a full travel, the cell sticks (sticks: true, mu_dynamic: null). Then the cell
+    before a full travel, the cell sticks (sticks: true, mu_dynamic: null); a travel timed at
+    a held angle above DYNAMIC_MAX_ANGLE_DEG (85) gives mu_dynamic: null with sticks: false
+    (a = g (sin t - mu cos t) no longer depends on mu there). Then the cell
     is stopped (all velocities zeroed, as the operator catches it), the table tilted back
     and the scene settled (restore=False: not, the scene is discarded after the step).
     Particles that leave spill_box are erased and counted.
@@ -424,7 +427,8 @@ def tilt_test(scene, tilt, cell, lid, plate_ids, spill_box, proc, record, step_i
                 travel_time = ts[k - 1] + frac * (ts[k] - ts[k - 1])
                 acc = _fit_acceleration(ts, xs)
                 th = math.radians(dyn_angle)
-                mu_dyn = math.tan(th) - acc / (g * math.cos(th))
+                if dyn_angle <= DYNAMIC_MAX_ANGLE_DEG:      # above it cos t ~ 0 and mu is lost
+                    mu_dyn = math.tan(th) - acc / (g * math.cos(th))
                 out.update({"dynamic_acceleration_m_s2": acc})
                 break
             if angle >= max_tilt:
@@ -439,7 +443,7 @@ def tilt_test(scene, tilt, cell, lid, plate_ids, spill_box, proc, record, step_i
                 if x - x_stop >= onset_d:
                     break
         slid = cell.pos[0] - x0
-        sticks = mu_dyn is None
+        sticks = travel_time is None
     else:
         slid = cell.pos[0] - x0
         sticks = True
