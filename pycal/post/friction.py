@@ -164,6 +164,26 @@ STICKS_MU = 2.0   # a simulated step where the cell did not slide even at max ti
                   # this friction coefficient (tan 63 deg: above every lab value here)
 
 
+def _lab_target(result, quantity, targets):
+    """The lab target of `quantity` for this result (targets default: its lab curve)."""
+    if targets is None:
+        targets = load_targets(result["rig"], lab_sample_of(result))
+    t = targets.get(quantity)
+    if not t:
+        raise ValueError(f"{result.get('job_id', result.get('rig'))}: no lab curve of {quantity} to compare with")
+    return t
+
+
+def compared_values(result, quantity):
+    """Per simulated step the value a calibration compares with the lab: STICKS_MU where
+    the cell stuck or gave no value (mu_dynamic above DYNAMIC_MAX_ANGLE_DEG included)."""
+    out = []
+    for k, stuck in enumerate(result["sticks"]):
+        v = dynamic_value(result, k) if quantity == "mu_dynamic" else result[quantity][k]
+        out.append(STICKS_MU if stuck or v is None else v)
+    return out
+
+
 def friction_offset(result, quantity="mu_static", min_stress_pa=10000.0, targets=None):
     """Mean over the simulated steps at or above min_stress_pa of (simulated - lab)
     `quantity`, the lab curve interpolated in log(stress) at the simulated stress; lab
@@ -174,11 +194,8 @@ def friction_offset(result, quantity="mu_static", min_stress_pa=10000.0, targets
     steps say little about the contact friction.
     targets: as load_targets (default: the lab curve of the rig and the material)."""
     from .compression import interp_log_stress
-    if targets is None:
-        targets = load_targets(result["rig"], lab_sample_of(result))
-    t = targets.get(quantity)
-    if not t:
-        raise ValueError(f"{result.get('job_id', result.get('rig'))}: no lab curve of {quantity} to compare with")
+    t = _lab_target(result, quantity, targets)
+    sim = compared_values(result, quantity)
     slides = [i for i, o in enumerate(t["outcome"]) if o == "slides" and t["value"][i] is not None]
     lab_s = [t["stress_pa"][i] for i in slides]
     lab_v = [t["value"][i] for i in slides]
@@ -189,9 +206,7 @@ def friction_offset(result, quantity="mu_static", min_stress_pa=10000.0, targets
         lab = interp_log_stress(lab_s, lab_v, s, extrapolate_ratio=0.0)
         if lab is None:
             continue
-        v = dynamic_value(result, k) if quantity == "mu_dynamic" else result[quantity][k]
-        sim = STICKS_MU if result["sticks"][k] or v is None else v
-        diffs.append(sim - lab)
+        diffs.append(sim[k] - lab)
     if not diffs:
         raise ValueError(f"{result.get('job_id', result.get('rig'))}: no simulated step at or above "
                          f"{min_stress_pa:g} Pa where the lab cell slides")
@@ -205,14 +220,8 @@ def friction_band_z(result, quantity="mu_static", min_stress_pa=10000.0, targets
     step that sticks counts as STICKS_MU). |z| <= 1 is inside the band: the residual
     vector of the calibration's joint stages."""
     from .compression import interp_log_stress, band_z
-    if targets is None:
-        targets = load_targets(result["rig"], lab_sample_of(result))
-    t = targets.get(quantity)
-    if not t:
-        raise ValueError(f"{result.get('job_id', result.get('rig'))}: no lab curve of {quantity} to compare with")
-    vals = ([dynamic_value(result, k) for k in range(len(result["stress_pa"]))] if quantity == "mu_dynamic"
-            else result[quantity])
-    sim = [STICKS_MU if st or v is None else v for st, v in zip(result["sticks"], vals)]
+    t = _lab_target(result, quantity, targets)
+    sim = compared_values(result, quantity)
     out = []
     for i, s in enumerate(t["stress_pa"]):
         if s < min_stress_pa or t["outcome"][i] != "slides" or t["value"][i] is None:
