@@ -20,6 +20,7 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 
 from . import REPO_ROOT  # noqa: E402
+from .calibration.study import row_values  # noqa: E402
 
 
 def _png_b64(fig):
@@ -91,7 +92,7 @@ def write_report(study_dir, yade_version="unknown"):
              "<th>response</th><th>simulated (mean +/- std)</th><th>lab target</th><th>tolerance</th>"
              "<th>met</th><th>note</th></tr>"]
     for s in stages:
-        shown = dict(s, value="; ".join(f"{k} = {v:.4g}" for k, v in s["values"].items())) if s.get("values") else s
+        shown = dict(s, value="; ".join(f"{k} = {v:.4g}" for k, v in row_values(s).items())) if s.get("values") else s
         parts.append("<tr>" + "".join(f"<td>{_fmt(shown.get(k, ''))}</td>" for k in
                                       ("material", "stage", "parameter", "value", "response")) +
                      f"<td>{_fmt(s['response_mean'])} +/- {_fmt(s['response_std'])}</td>"

@@ -16,7 +16,7 @@ NOT_YET = ["wet fines-fines cohesion against the wet internal-friction curve (th
 def _cmd_calibrate(args):
     from ..runner import make_executor, DEFAULT_RUNS_DIR
     from ..report import write_report
-    from .study import Study
+    from .study import Study, row_values
     runs = Path(args.runs or DEFAULT_RUNS_DIR)
     executor = make_executor(args.executor, runs_dir=runs, workers=args.workers, timeout_s=args.timeout_s)
     study = Study(args.config, executor, Path(args.out or runs / "study"))
@@ -32,8 +32,8 @@ def _cmd_calibrate(args):
         flag = "met    " if r["met"] else "NOT met"
         resp = (f"{r['response']} {r['response_mean']:.4g} +/- {r['response_std']:.2g} vs lab "
                 f"{r['target']:.4g} (tolerance {r['tolerance']:.3g})") if r["response"] else r["message"]
-        print(f"  {flag} {r['material']:7s} {r['stage']:18s} {r['parameter'].split('+')[0]} = "
-              f"{r['value']:.4g}: {resp}")
+        values = ", ".join(f"{k.split('+')[0]} = {v:.4g}" for k, v in row_values(r).items())
+        print(f"  {flag} {r['material']:7s} {r['stage']:18s} {values}: {resp}")
     print("stages of the method not run by this engine yet: " + "; ".join(NOT_YET))
     print(f"calibrated materials: {study.out / 'calibrated'}\nreport: {report}")
 

@@ -135,6 +135,11 @@ def load_study(path):
     return data
 
 
+def row_values(row):
+    """{parameter: value} of a stage row (a joint stage has several)."""
+    return row.get("values") or {row["parameter"]: row["value"]}
+
+
 def stage_label(st):
     """The name of a stage in outputs and `inherit`: its `name`, else its stage type."""
     return st.get("name", st["stage"])
@@ -386,8 +391,7 @@ class Study:
                            "met": False, "message": f"runs failed: {exc}", "evaluations": 0}
                 row.update({"material": material, "stage": stage_label(st), "kind": st["stage"]})
                 self.stage_rows.append(row)
-                shown = row.get("values") or {row["parameter"]: row["value"]}
-                self.log(f"  -> {', '.join(f'{k} = {v:.4g}' for k, v in shown.items())}: "
+                self.log(f"  -> {', '.join(f'{k} = {v:.4g}' for k, v in row_values(row).items())}: "
                          + ("target met" if row["met"] else f"NOT met {row['message']}"))
                 self.write_outputs()
         return self.stage_rows
