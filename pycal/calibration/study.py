@@ -160,6 +160,7 @@ class Study:
         self.stage_rows, self.history = [], []
         self.runs_requested = 0
         self.point_results = {}      # (material, stage label, parameters json) -> results of that point
+        self.vector_length = {}      # (material, stage label) -> residuals per point of a joint stage
         self.t0 = time.time()
 
     # ---------- evaluation ----------
@@ -284,13 +285,25 @@ class Study:
         step no seed reached stays None); the history gets its RMS."""
         from .joint import rms
         overrides = {**self.overrides[material], **extra}
-        results = list(self._run_seeds(rig, material, overrides, self.seeds))
+        try:
+            results = list(self._run_seeds(rig, material, overrides, self.seeds))
+        except RunError as exc:
+            # a parameter pair where the rig cannot run (e.g. a blow-up) is a bad point for
+            # the fit, not the end of it: every residual counts as not reached
+            n = self.vector_length.get((material, stage_name))
+            if n is None:
+                raise
+            self.history.append({"material": material, "stage": stage_name, "rig": rig, "parameters": dict(extra),
+                                 "response": f"RMS {response}", "mean": math.nan, "std": math.nan, "n": 0})
+            self.log(f"  {material} {stage_name}: {extra} -> runs failed, counted as a bad point: {exc}")
+            return [None] * n
         vectors = [vector_responses(lab_dir)[response](r) for r in results]
         mean = []
         for k in range(max(len(v) for v in vectors)):
             vals = [v[k] for v in vectors if k < len(v) and v[k] is not None]
             mean.append(sum(vals) / len(vals) if vals else None)
         per_seed = [rms(v) for v in vectors]
+        self.vector_length[(material, stage_name)] = len(mean)
         self.point_results[(material, stage_name, json.dumps(extra, sort_keys=True))] = results
         self.history.append({"material": material, "stage": stage_name, "rig": rig, "parameters": dict(extra),
                              "response": f"RMS {response}", "mean": rms(mean),

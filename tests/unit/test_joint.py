@@ -114,3 +114,52 @@ materials:
     with pytest.raises(ConfigError) as exc:
         load_study(p)
     assert "bad.yaml" in str(exc.value) and "materials.M3-wet[0]" in str(exc.value)
+
+
+def test_joint_fit_step_is_a_share_of_the_range_even_at_a_start_near_a_bound():
+    """The forward-difference step must move a parameter that starts near its lower
+    bound by several % of its range (scipy's step is relative to the variable)."""
+    seen = []
+
+    def f(x):
+        seen.append(list(x))
+        return [(x[0] - 0.4) / 0.05, (x[1] - 0.02) / 0.005]
+    solve_joint(f, [0.5, 0.001], [0.05, 0.0], [1.2, 0.05], 1e-9, max_evaluations=3)
+    steps = [abs(b - a) for a, b in zip(seen[0], seen[1]) if b != a] + \
+            [abs(b - a) for a, b in zip(seen[0], seen[2]) if b != a]
+    assert len(steps) == 2
+    assert steps[0] >= 0.04 * 1.15 and steps[1] >= 0.04 * 0.05
+
+
+def test_a_failed_point_is_a_bad_point_and_the_fit_goes_on(tmp_path):
+    from pycal.errors import RunError
+    cfg = tmp_path / "wet.yaml"
+    cfg.write_text("""
+name: wet
+seeds_count: 1
+materials:
+  M3-wet:
+    - stage: joint
+      rig: wall_friction
+      response: friction_band_z_mu_static
+      tolerance_rms_z: 0.01
+      parameters:
+        - {keys: [interactions.steel.friction_coefficient], bounds: [0.05, 1.2]}
+        - {keys: [interactions.steel.rolling_resistance_coefficient], start: 0.35, bounds: [0.0, 1.0]}
+      max_iterations_count: 6
+""")
+    stress = [12000, 24000, 40000, 60000, 86000]
+
+    class Flaky:
+        def run(self, jobs):
+            steel = jobs[0]["materials"]["M3-wet"]["interactions"]["steel"]
+            if steel["rolling_resistance_coefficient"] > 0.36:     # the rig blows up up there
+                raise RunError("wall_friction: RIG FAILED: blow-up")
+            mu = [steel["friction_coefficient"] - 0.2 + 4e-6 * s for s in stress]
+            return [{"rig": "wall_friction", "material": "M3-wet", "job": j, "stress_pa": stress,
+                     "mu_static": mu, "mu_dynamic": mu, "sticks": [False] * 5} for j in jobs]
+    study = Study(cfg, Flaky(), tmp_path / "out", log=lambda m: None)
+    (row,) = study.run()
+    failed = [h for h in study.history if h["n"] == 0]
+    assert failed, "the fit should have tried a point where the rig fails"
+    assert row["evaluations"] > len(failed) and math.isfinite(row["response_mean"])
