@@ -10,7 +10,8 @@ scipy.optimize.least_squares (trust-region reflective, bounded) works on the par
 scaled to u in [1, 2] within their bounds (u = 1 + (x - lo) / (hi - lo)): scipy's
 forward-difference step is relative (h = diff_step x u), so on [1, 2] it is 5-10 % of
 each parameter's range whatever its start - large enough to stand above the seed noise
-(on [0, 1] a start near the lower bound got a step of 0.05 % of the range: measured).
+(on [0, 1] the wet wall fit stepped 2 % of the friction range and would have stepped
+0.5 % of the pressure-fraction range, which started near its lower bound: measured).
 Every evaluated point is rounded to 4 significant digits (a rerun of the same study
 asks for the same jobs and hits the cache), and the best point seen is returned: with
 noisy responses the optimizer's last point need not be the best. The fit stops as soon
