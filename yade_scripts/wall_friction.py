@@ -18,7 +18,6 @@ import sys
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(sys.argv[0])))  # yade -x: __file__ is not the script
 from demlib.jobio import run_rig  # noqa: E402
-from demlib.scene import Scene  # noqa: E402
 from demlib import tilt as tl  # noqa: E402
 
 
@@ -42,10 +41,7 @@ def build(scene):
 
 
 def main(job, out_dir):
-    def make_scene():
-        scene = Scene(job)
-        return scene, build(scene)
-    return tl.run_friction_rig(make_scene, out_dir)
+    return tl.run_friction_rig(job, build, out_dir)
 
 
 run_rig(main)

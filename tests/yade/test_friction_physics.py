@@ -151,6 +151,17 @@ PAIR_SCENE = textwrap.dedent('''
 ''')
 
 
+
+def run_pair_scene(d, cases):
+    """Run PAIR_SCENE in folder d on {name: {job, press}}; returns {name: displacement m}."""
+    (d / "cases.json").write_text(json.dumps({"cases": cases}))
+    (d / "pair.py").write_text(PAIR_SCENE)
+    proc = subprocess.run(["yade", "-j1", "-x", "-n", "pair.py", "cases.json", str(REPO_ROOT)], cwd=d,
+                          capture_output=True, text=True, timeout=300, env={**os.environ, "OMP_NUM_THREADS": "1"})
+    out = d / "pair.json"
+    assert proc.returncode == 0 and out.is_file(), proc.stdout[-2000:] + proc.stderr[-2000:]
+    return json.loads(out.read_text())
+
 @pytest.fixture(scope="module")
 def pair(tmp_path_factory):
     d = tmp_path_factory.mktemp("pair")
@@ -168,13 +179,7 @@ def pair(tmp_path_factory):
         "hyst_pressed": {"job": job({"model": "hysteretic", "force_fraction": 0.5, "pressure_fraction": 0.1,
                                      "update_interval_s": 0.005}), "press": 20},
     }
-    (d / "cases.json").write_text(json.dumps({"cases": cases}))
-    (d / "pair.py").write_text(PAIR_SCENE)
-    proc = subprocess.run(["yade", "-j1", "-x", "-n", "pair.py", "cases.json", str(REPO_ROOT)], cwd=d,
-                          capture_output=True, text=True, timeout=300, env={**os.environ, "OMP_NUM_THREADS": "1"})
-    out = d / "pair.json"
-    assert proc.returncode == 0 and out.is_file(), proc.stdout[-2000:] + proc.stderr[-2000:]
-    return json.loads(out.read_text())
+    return run_pair_scene(d, cases)
 
 
 def test_bond_above_weight_holds_below_parts(pair):
@@ -209,13 +214,7 @@ def test_liquid_bridge_holds_when_stronger_than_weight(tmp_path_factory):
         return resolve_job("wall_friction", "M2", o, seed=SEED)
 
     cases = {"strong": {"job": job(3.0), "press": 0}, "weak": {"job": job(1.0 / 3.0), "press": 0}}
-    (d / "cases.json").write_text(json.dumps({"cases": cases}))
-    (d / "pair.py").write_text(PAIR_SCENE)
-    proc = subprocess.run(["yade", "-j1", "-x", "-n", "pair.py", "cases.json", str(REPO_ROOT)], cwd=d,
-                          capture_output=True, text=True, timeout=300, env={**os.environ, "OMP_NUM_THREADS": "1"})
-    out = d / "pair.json"
-    assert proc.returncode == 0 and out.is_file(), proc.stdout[-2000:] + proc.stderr[-2000:]
-    res = json.loads(out.read_text())
+    res = run_pair_scene(d, cases)
     assert res["strong"] < 0.002
     assert res["weak"] > 0.005
 

@@ -520,10 +520,10 @@ STEP_KEYS = ("mu_static", "mu_dynamic", "sticks", "max_tilt_deg", "onset_angle_d
 FILL_MODES = ("sequential", "fresh")
 
 
-def run_friction_rig(make_scene, out_dir):
+def run_friction_rig(job, build, out_dir):
     """For each consolidation stress in order: consolidate, tilt test.
 
-    make_scene() -> (scene, parts) builds and fills the rig (a new YADE scene).
+    build(scene) -> parts builds and fills the rig in a new Scene(job).
     procedure.fill_each_step: 'sequential' - one fill, the steps follow each other on it
     (the lab's procedure: the table returns to horizontal, the cell is put back);
     'fresh' - a new fill for every step (same seed, so the same fill: the steps differ
@@ -536,6 +536,12 @@ def run_friction_rig(make_scene, out_dir):
     spring_curve.csv, tilt_record.csv; returns the measurements."""
     import time
     from .jobio import write_csv
+    from .scene import Scene
+
+    def make_scene():
+        scene = Scene(job)
+        return scene, build(scene)
+
     scene, parts = make_scene()
     g, p = scene.rig["geometry"], scene.rig["procedure"]
     fresh = p["fill_each_step"] == "fresh"
