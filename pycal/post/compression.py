@@ -392,6 +392,21 @@ def write_comparison_csv(comparisons, path):
     return path
 
 
+def unloading_stiffness_log_ratio(result, min_stress_pa=10000.0, lab_dir=None):
+    """log of the geometric mean of simulated / lab unloading stiffness over the lab's
+    unloading steps at or above min_stress_pa (below it particles lose contact and the
+    lab curve drops). 0 = on the lab curve; a calibration response that rises with E."""
+    targets = load_targets(result["rig"], lab_sample_of(result), lab_dir)
+    comp = compare(derived_arrays(dict(result)), targets).get("unloading_stiffness")
+    if comp is None:
+        raise ValueError(f"{result.get('job_id')}: no unloading stiffness to compare with a lab curve")
+    logs = [math.log(s / v) for s, v, st in zip(comp["sim_at_lab"], comp["lab_value"], comp["lab_stress_pa"])
+            if s is not None and v and s > 0 and st >= min_stress_pa]
+    if not logs:
+        raise ValueError(f"{result.get('job_id')}: no unloading step at or above {min_stress_pa} Pa")
+    return sum(logs) / len(logs)
+
+
 def main(argv=None):
     argv = sys.argv[1:] if argv is None else argv
     if not argv:
@@ -411,18 +426,3 @@ def main(argv=None):
 
 if __name__ == "__main__":
     sys.exit(main())
-
-
-def unloading_stiffness_log_ratio(result, min_stress_pa=10000.0, lab_dir=None):
-    """log of the geometric mean of simulated / lab unloading stiffness over the lab's
-    unloading steps at or above min_stress_pa (below it particles lose contact and the
-    lab curve drops). 0 = on the lab curve; a calibration response that rises with E."""
-    targets = load_targets(result["rig"], lab_sample_of(result), lab_dir)
-    comp = compare(derived_arrays(dict(result)), targets).get("unloading_stiffness")
-    if comp is None:
-        raise ValueError(f"{result.get('job_id')}: no unloading stiffness to compare with a lab curve")
-    logs = [math.log(s / v) for s, v, st in zip(comp["sim_at_lab"], comp["lab_value"], comp["lab_stress_pa"])
-            if s is not None and v and s > 0 and st >= min_stress_pa]
-    if not logs:
-        raise ValueError(f"{result.get('job_id')}: no unloading step at or above {min_stress_pa} Pa")
-    return sum(logs) / len(logs)

@@ -1,26 +1,11 @@
 """Config loading and validation: shipped configs load; broken ones name file and field."""
-import shutil
-
 import pytest
 
-from pycal import CONFIG_DIR
 from pycal.configs import (load_boundaries, load_material, load_rig, material_names, rig_names,
                            parse_yaml_text)
 from pycal.errors import ConfigError
 
-
-@pytest.fixture
-def cfg(tmp_path):
-    """A writable copy of configs/."""
-    dst = tmp_path / "configs"
-    shutil.copytree(CONFIG_DIR, dst)
-    return dst
-
-
-def edit(path, old, new):
-    text = path.read_text()
-    assert old in text, f"{old!r} not in {path}"
-    path.write_text(text.replace(old, new, 1))
+from config_copy import edit
 
 
 def test_shipped_configs_load():

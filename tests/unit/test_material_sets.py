@@ -14,18 +14,9 @@ from pycal.errors import ConfigError
 from pycal.jobs import resolve_job
 from pycal.post import aor_mixed
 
-
-@pytest.fixture
-def cfg(tmp_path):
-    dst = tmp_path / "configs"
-    shutil.copytree(CONFIG_DIR, dst)
-    return dst
+from config_copy import edit
 
 
-def edit(path, old, new):
-    text = path.read_text()
-    assert old in text, f"{old!r} not in {path}"
-    path.write_text(text.replace(old, new, 1))
 
 
 def test_shipped_sets_have_the_lab_fractions_of_the_minus_50_mm_sample():
