@@ -1,4 +1,5 @@
 """`pycal calibrate`: run a calibration study and write its report (the main job)."""
+import os
 import time
 from pathlib import Path
 
@@ -16,9 +17,14 @@ NOT_YET = ["wet fines-fines cohesion against the wet internal-friction curve (th
 def _cmd_calibrate(args):
     from ..runner import make_executor, DEFAULT_RUNS_DIR
     from ..report import write_report
-    from .study import Study, row_values
+    from .study import Study, row_values, load_study
     runs = Path(args.runs or DEFAULT_RUNS_DIR)
-    executor = make_executor(args.executor, runs_dir=runs, workers=args.workers, timeout_s=args.timeout_s)
+    workers = args.workers
+    if workers is None:
+        # a point runs seeds_count jobs at once: one worker per seed (3 on 2 cores) keeps
+        # both cores busy to the end of a point instead of leaving one idle for the last seed
+        workers = max(os.cpu_count() or 1, int(load_study(args.config)["seeds_count"]))
+    executor = make_executor(args.executor, runs_dir=runs, workers=workers, timeout_s=args.timeout_s)
     study = Study(args.config, executor, Path(args.out or runs / "study"))
     t0 = time.time()
     print(f"calibration study {study.cfg['name']} ({args.config}): {len(study.seeds)} seeds per point, "
@@ -44,7 +50,7 @@ def register(sub):
     s.add_argument("--config", default=str(DEFAULT_STUDY), help="study config (configs/calibrations/*.yaml)")
     s.add_argument("--runs", default=None, help="runs directory: the job cache (default runs/)")
     s.add_argument("--out", default=None, help="study output folder (default <runs>/study)")
-    s.add_argument("--workers", type=int, default=None, help="parallel YADE processes (default: cores)")
+    s.add_argument("--workers", type=int, default=None, help="parallel YADE processes (default: cores, at least seeds_count)")
     s.add_argument("--executor", default="local", choices=["local", "yade-batch"])
     s.add_argument("--timeout-s", type=float, default=3600.0, help="timeout per job in seconds")
     s.set_defaults(func=_cmd_calibrate)

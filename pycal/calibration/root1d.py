@@ -39,7 +39,7 @@ def effective_tolerance(point, tolerance):
 
 
 def solve_monotone(evaluate, target, x0, lo, hi, tolerance, max_evaluations=6, first_step=None,
-                   increasing=None):
+                   increasing=None, slope_estimate=None):
     """Find x in [lo, hi] with response(x) = target within tolerance.
 
     Strategy: evaluate the start x0; step towards the target (direction from a second
@@ -49,6 +49,9 @@ def solve_monotone(evaluate, target, x0, lo, hi, tolerance, max_evaluations=6, f
     the closest bound is returned with met=False and a message saying so).
     increasing: the response's direction when physics knows it (True/False); None =
     learn it from the first two points (unsafe when the noise is larger than the change).
+    slope_estimate: |d response / d x| known from physics (e.g. wall friction of the bulk
+    ~ 1.03 x the particle-steel friction): the second point is then a Newton step,
+    |misfit| / slope, instead of a quarter of the bounds.
     """
     if not lo <= x0 <= hi:
         raise ValueError(f"start {x0} outside bounds [{lo}, {hi}]")
@@ -67,6 +70,8 @@ def solve_monotone(evaluate, target, x0, lo, hi, tolerance, max_evaluations=6, f
     if abs(p0.misfit(target)) <= effective_tolerance(p0, tolerance):
         return done(p0)
     step = first_step if first_step is not None else 0.25 * (hi - lo)
+    if slope_estimate:
+        step = abs(p0.misfit(target)) / abs(slope_estimate)
     if increasing is None:
         # probe a second point to learn the slope's sign
         x1 = min(hi, x0 + step) if x0 + step <= hi else max(lo, x0 - step)

@@ -66,3 +66,18 @@ def test_known_direction_is_not_fooled_by_noise():
     sol = solve_monotone(evaluate, target=42.0, x0=0.35, lo=0.02, hi=1.5, tolerance=2.0,
                          increasing=True)
     assert all(b > a for a, b in zip(seen, seen[1:])) and sol.met
+
+
+def test_slope_estimate_gives_a_newton_second_point():
+    # wall friction of the bulk ~ 1.03 x particle-steel friction - 0.1: from 0.5 the
+    # known slope lands the second point next to the root (a quarter of the bounds would
+    # have gone to 0.79)
+    seen = []
+
+    def evaluate(x):
+        seen.append(x)
+        return 1.03 * x - 0.1 - 0.5, 0.01, 3      # offset from a lab plateau of 0.5
+    sol = solve_monotone(evaluate, target=0.0, x0=0.5, lo=0.05, hi=1.2, tolerance=0.03,
+                         increasing=True, slope_estimate=1.0)
+    assert seen[1] == pytest.approx(0.5 + 0.085)
+    assert sol.met and len(sol.history) == 2

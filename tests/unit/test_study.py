@@ -142,6 +142,14 @@ def test_noisy_points_get_more_seeds(tmp_path):
     assert n == 8                                   # 2 -> 4 -> 8 seeds: the noise stays above tolerance
     m, s, n = study.evaluate("aor", "M3-dry", {}, "aor_mean_deg", "rolling_resistance", tolerance=50.0)
     assert n == 2                                   # quiet enough for a loose tolerance
+    # a point whose whole +-2 standard errors lie off the target's tolerance band is not
+    # in doubt: its 2 seeds already say which way to go
+    m, s, n = study.evaluate("aor", "M3-dry", {}, "aor_mean_deg", "rolling_resistance", tolerance=2.0,
+                             target=m + 30.0)
+    assert n == 2
+    m, s, n = study.evaluate("aor", "M3-dry", {}, "aor_mean_deg", "rolling_resistance", tolerance=2.0,
+                             target=m + 3.0)
+    assert n == 8                                   # in doubt: more seeds
 
 
 def test_stiffness_stage_solves_in_log_space(tmp_path):
