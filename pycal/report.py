@@ -20,7 +20,7 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 
 from . import REPO_ROOT  # noqa: E402
-from .calibration.study import row_values  # noqa: E402
+from .calibration.study import row_values, cost_per_material  # noqa: E402
 
 
 def _png_b64(fig):
@@ -99,6 +99,12 @@ def write_report(study_dir, yade_version="unknown"):
                      f"<td>{_fmt(s['target'])}</td><td>{_fmt(s['tolerance'])}</td>"
                      f"<td class='{'yes' if s['met'] else 'no'}'>{'yes' if s['met'] else 'NO'}</td>"
                      f"<td>{_fmt(s.get('message', ''))}</td></tr>")
+    parts.append("</table><h2>Cost per material</h2><p>Runs requested (cached ones included), runs simulated "
+                 "by YADE and wall time in the invocation that wrote this report.</p><table><tr><th>material</th>"
+                 "<th>runs requested</th><th>runs simulated</th><th>wall time s</th></tr>")
+    for mat, c in cost_per_material(stages).items():
+        parts.append(f"<tr><td>{html.escape(mat)}</td><td>{c['runs_requested']}</td>"
+                     f"<td>{c['runs_simulated']}</td><td>{c['elapsed_s']:.0f}</td></tr>")
     parts.append("</table><h2>Calibrated materials</h2>")
     for mat, ov in summary["overrides"].items():
         parts.append(f"<h3>{html.escape(mat)}</h3><p>file: calibrated/{html.escape(mat)}.yaml</p>"

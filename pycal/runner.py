@@ -118,6 +118,7 @@ class LocalPool:
         self.workers = workers or os.cpu_count() or 1
         self.timeout_s = timeout_s
         self.progress = progress
+        self.simulated_count = 0     # jobs actually run by YADE (not from the cache), for the study's cost table
 
     def run(self, jobs, raise_on_error=True):
         """Run jobs; returns results in the order of `jobs` (None for a failed job
@@ -131,6 +132,7 @@ class LocalPool:
             else:
                 todo.append(i)
         t0, done, errors = time.time(), 0, []
+        self.simulated_count += len(todo)
         if self.progress and todo:
             _say(f"running {len(todo)} job(s) ({len(jobs) - len(todo)} cached) on {self.workers} worker(s)")
         with ThreadPoolExecutor(max_workers=self.workers) as pool:
@@ -162,10 +164,12 @@ class YadeBatch:
         self.workers = workers or os.cpu_count() or 1
         self.timeout_s = timeout_s
         self.progress = progress
+        self.simulated_count = 0     # jobs actually run by YADE (not from the cache), for the study's cost table
 
     def run(self, jobs, raise_on_error=True):
         results = [cached_result(j, self.runs_dir) for j in jobs]
         todo = [i for i, r in enumerate(results) if r is None]
+        self.simulated_count += len(todo)
         by_script = {}
         for i in todo:
             by_script.setdefault(jobs[i]["script"], []).append(i)

@@ -17,7 +17,7 @@ NOT_YET = ["wet fines-fines cohesion against the wet internal-friction curve (th
 def _cmd_calibrate(args):
     from ..runner import make_executor, DEFAULT_RUNS_DIR
     from ..report import write_report
-    from .study import Study, row_values, load_study
+    from .study import Study, row_values, load_study, cost_per_material
     runs = Path(args.runs or DEFAULT_RUNS_DIR)
     workers = args.workers
     if workers is None:
@@ -40,6 +40,9 @@ def _cmd_calibrate(args):
                 f"{r['target']:.4g} (tolerance {r['tolerance']:.3g})") if r["response"] else r["message"]
         values = ", ".join(f"{k.split('+')[0]} = {v:.4g}" for k, v in row_values(r).items())
         print(f"  {flag} {r['material']:7s} {r['stage']:18s} {values}: {resp}")
+    for m, c in cost_per_material(rows).items():
+        print(f"  {m}: {c['runs_requested']} runs requested, {c['runs_simulated']} simulated, "
+              f"{c['elapsed_s']:.0f} s")
     print("stages of the method not run by this engine yet: " + "; ".join(NOT_YET))
     print(f"calibrated materials: {study.out / 'calibrated'}\nreport: {report}")
 

@@ -404,6 +404,8 @@ class Study:
         for material, stages in self.cfg["materials"].items():
             for st in stages:
                 k += 1
+                t_stage, runs_before = time.time(), self.runs_requested
+                simulated_before = getattr(self.executor, "simulated_count", 0)
                 self.log(f"[stage {k}/{n_stages}] {material}: {stage_label(st)}"
                          + (f" on rig {st['rig']}" if "rig" in st else ""))
                 try:
@@ -415,7 +417,10 @@ class Study:
                            "response": st.get("response", ""), "response_mean": math.nan,
                            "response_std": math.nan, "target": math.nan, "tolerance": math.nan,
                            "met": False, "message": f"runs failed: {exc}", "evaluations": 0}
-                row.update({"material": material, "stage": stage_label(st), "kind": st["stage"]})
+                row.update({"material": material, "stage": stage_label(st), "kind": st["stage"],
+                            "runs_requested": self.runs_requested - runs_before,
+                            "runs_simulated": getattr(self.executor, "simulated_count", 0) - simulated_before,
+                            "elapsed_s": round(time.time() - t_stage, 1)})
                 self.stage_rows.append(row)
                 self.log(f"  -> {', '.join(f'{k} = {v:.4g}' for k, v in row_values(row).items())}: "
                          + ("target met" if row["met"] else f"NOT met {row['message']}"))
@@ -437,7 +442,8 @@ class Study:
             _atomic(self.out / "calibrated" / f"{m}.yaml",
                     yaml.safe_dump(self.calibrated_material(m), sort_keys=False))
         cols = ["material", "stage", "parameter", "value", "response", "response_mean",
-                "response_std", "target", "tolerance", "met", "evaluations", "message"]
+                "response_std", "target", "tolerance", "met", "evaluations", "runs_requested",
+                "runs_simulated", "elapsed_s", "message"]
         _atomic_csv(self.out / "stages.csv", cols, [[r.get(c, "") for c in cols] for r in self.stage_rows])
         hcols = ["material", "stage", "rig", "parameters", "response", "mean", "std", "n"]
         _atomic_csv(self.out / "history.csv", hcols,
@@ -470,3 +476,14 @@ def _atomic_csv(path, columns, rows):
         w.writerow(columns)
         w.writerows(rows)
     os.replace(tmp, path)
+
+
+def cost_per_material(stage_rows):
+    """{material: {runs_requested, runs_simulated, elapsed_s}} summed over its stages
+    (elapsed: of this invocation; a resumed study replays cached runs in seconds)."""
+    out = {}
+    for r in stage_rows:
+        c = out.setdefault(r["material"], {"runs_requested": 0, "runs_simulated": 0, "elapsed_s": 0.0})
+        for k in c:
+            c[k] += r.get(k, 0) or 0
+    return out

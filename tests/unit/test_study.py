@@ -100,6 +100,9 @@ def test_study_recovers_known_parameters(tmp_path, study_file):
     # report
     html = write_report(tmp_path / "out" / "twin").read_text()
     assert "4 of 4 stage targets met" in html and "data:image/png;base64" in html
+    # cost per stage and per material: every run of the study is counted once
+    assert sum(r["runs_requested"] for r in rows) == study.runs_requested > 0
+    assert "Cost per material" in html and "runs_simulated" in (tmp_path / "out" / "twin" / "stages.csv").read_text()
 
 
 def test_rerun_simulates_nothing_new(tmp_path, study_file):
