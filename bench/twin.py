@@ -21,10 +21,11 @@ import argparse
 import datetime
 import json
 import platform
-import shutil
 import sys
 import time
 from pathlib import Path
+
+import yaml
 
 ROOT = Path(__file__).resolve().parent.parent
 sys.path.insert(0, str(ROOT))
@@ -63,7 +64,6 @@ def simulate_targets(pool, seeds, lab, wall_friction=True):
     exp = run("ccs_expansion")
     wall = run("wall_friction", WALL_STEPS) if wall_friction else []
     (lab / "curves").mkdir(parents=True, exist_ok=True)
-    shutil.copy(LAB_DIR / "samples.yaml", lab / "samples.yaml")   # particle density of the lab sample
     # unloading stiffness per unloading step, mean over seeds, band +-30 %
     rows = {}
     for r in exp:
@@ -84,6 +84,12 @@ def simulate_targets(pool, seeds, lab, wall_friction=True):
         lines.append(f"{s:.0f},{ms:.4f},{ms - 0.03:.4f},{ms + 0.03:.4f},{md:.4f},{md - 0.03:.4f},{md + 0.03:.4f},synthetic")
     if wall:
         (lab / "curves" / "wall_friction_gravel_dry.csv").write_text("\n".join(lines) + "\n")
+    # the lab's samples (particle density of the sample, ...), each listing only the curves the twin wrote
+    samples = yaml.safe_load((LAB_DIR / "samples.yaml").read_text())
+    for sample in samples["samples"].values():
+        sample["curves"] = [c for c in sample.get("curves", []) if (lab / "curves" / f"{c}.csv").is_file()]
+    (lab / "samples.yaml").write_text("# synthetic twin (bench/twin.py): labresults/samples.yaml, twin curves only\n"
+                                      + yaml.safe_dump(samples, sort_keys=False))
     return {"bulk_density_kg_m3": mean_std([r["bulk_density_kg_m3"] for r in fill]),
             "aor_mean_deg": mean_std([r["aor_mean_deg"] for r in aor])}
 
