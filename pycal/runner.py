@@ -5,7 +5,10 @@ Layout under a runs directory:
     runs/<rig>/.<job_id>.tmp-<pid>/ in progress (renamed when complete)
     runs/<rig>/<job_id>.failed/     last failed attempt, kept for its log (never read as a result)
 
-A job whose folder has result.json is never run again. Executors share one
+A job whose folder has result.json is never run again. Neither is a job the rig itself
+refused (RigFailure: no rest, blow-up; <job_id>.failed/rig_failure.txt): the same job
+and seed fail the same way, so a resumed study does not pay for it twice. A crash, a
+timeout or a kill is not kept as a verdict: that job runs again. Executors share one
 interface, `run(jobs) -> list of results`, so a cluster executor can be added
 without touching the calibration code.
 """
@@ -34,6 +37,19 @@ def cached_result(job, runs_dir):
     path = job_dir(job, runs_dir) / "result.json"
     if path.is_file():
         return json.loads(path.read_text())
+    return None
+
+
+RIG_FAILURE_FILE = "rig_failure.txt"     # yade_scripts/demlib/jobio.py writes it on RigFailure
+
+
+def cached_failure(job, runs_dir):
+    """The message of a job the rig refused before (RigFailure), or None."""
+    failed = Path(str(job_dir(job, runs_dir)) + ".failed")
+    path = failed / RIG_FAILURE_FILE
+    if path.is_file():
+        return (f"{job['job_id']}: no result ({path.read_text().strip()}; kept from an earlier run: "
+                f"delete {failed} to run it again); log: {failed / 'yade.log'}")
     return None
 
 
@@ -87,6 +103,9 @@ def run_job(job, runs_dir=DEFAULT_RUNS_DIR, timeout_s=3600):
     cached = cached_result(job, runs_dir)
     if cached is not None:
         return cached
+    refused = cached_failure(job, runs_dir)
+    if refused:
+        raise RunError(refused)
     script = SCRIPT_DIR / job["script"]
     if not script.is_file():
         raise RunError(f"{job['rig']}: rig script {script} does not exist")
@@ -119,19 +138,23 @@ class LocalPool:
         self.timeout_s = timeout_s
         self.progress = progress
         self.simulated_count = 0     # jobs actually run by YADE (not from the cache), for the study's cost table
+        self.last_errors = []        # messages of the jobs that failed in the last run()
 
     def run(self, jobs, raise_on_error=True):
         """Run jobs; returns results in the order of `jobs` (None for a failed job
         when raise_on_error is False)."""
         results = [None] * len(jobs)
-        todo = []
+        todo, errors = [], []
         for i, job in enumerate(jobs):
             cached = cached_result(job, self.runs_dir)
+            refused = cached_failure(job, self.runs_dir) if cached is None else None
             if cached is not None:
                 results[i] = cached
+            elif refused:
+                errors.append(refused)
             else:
                 todo.append(i)
-        t0, done, errors = time.time(), 0, []
+        t0, done = time.time(), 0
         self.simulated_count += len(todo)
         if self.progress and todo:
             _say(f"running {len(todo)} job(s) ({len(jobs) - len(todo)} cached) on {self.workers} worker(s)")
@@ -151,8 +174,9 @@ class LocalPool:
                     eta = el / done * (len(todo) - done)
                     _say(f"[{done}/{len(todo)}] {jobs[i]['job_id']} {status} "
                          f"(elapsed {el:.0f} s, remaining ~{eta:.0f} s)")
+        self.last_errors = errors
         if errors and raise_on_error:
-            raise RunError(f"{len(errors)} of {len(todo)} job(s) failed; first: {errors[0]}")
+            raise RunError(f"{len(errors)} of {len(jobs)} job(s) failed; first: {errors[0]}")
         return results
 
 
@@ -165,15 +189,17 @@ class YadeBatch:
         self.timeout_s = timeout_s
         self.progress = progress
         self.simulated_count = 0     # jobs actually run by YADE (not from the cache), for the study's cost table
+        self.last_errors = []        # messages of the jobs that failed in the last run()
 
     def run(self, jobs, raise_on_error=True):
         results = [cached_result(j, self.runs_dir) for j in jobs]
-        todo = [i for i, r in enumerate(results) if r is None]
+        refused = {i: cached_failure(jobs[i], self.runs_dir) for i, r in enumerate(results) if r is None}
+        errors = [msg for msg in refused.values() if msg]
+        todo = [i for i, msg in refused.items() if not msg]
         self.simulated_count += len(todo)
         by_script = {}
         for i in todo:
             by_script.setdefault(jobs[i]["script"], []).append(i)
-        errors = []
         for script, idx in by_script.items():
             dirs = {i: _prepare(jobs[i], self.runs_dir) for i in idx}
             table = self.runs_dir / f".batch-{os.getpid()}-{Path(script).stem}.table"
@@ -198,6 +224,7 @@ class YadeBatch:
                 except RunError as exc:
                     errors.append(str(exc))
             table.unlink(missing_ok=True)
+        self.last_errors = errors
         if errors and raise_on_error:
             raise RunError(f"{len(errors)} job(s) failed; first: {errors[0]}")
         return results

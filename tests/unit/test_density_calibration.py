@@ -19,7 +19,7 @@ class FakeFill:
         self.density_effect = density_effect   # packing change per kg/m3 (heavier -> denser)
         self.calls = []
 
-    def run(self, jobs):
+    def run(self, jobs, raise_on_error=True):
         self.calls.append(jobs)
         out = []
         for job in jobs:
@@ -70,7 +70,7 @@ def test_converges_within_tolerance_in_three_iterations(tmp_path, density_effect
 
 def test_non_converging_is_reported_not_met(tmp_path):
     class Stuck(FakeFill):                      # bulk density does not respond to the particle density
-        def run(self, jobs):
+        def run(self, jobs, raise_on_error=True):
             return [{"bulk_density_kg_m3": 1000.0 + j["seed"], "solid_fraction": 0.3, "n_particles": 70}
                     for j in jobs]
     with pytest.warns(UserWarning, match="NOT CONVERGED"):

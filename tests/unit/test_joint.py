@@ -67,7 +67,7 @@ materials:
     stress = [3000, 6000, 12000, 24000, 40000, 60000, 86000]
 
     class Wet:
-        def run(self, jobs):
+        def run(self, jobs, raise_on_error=True):
             out = []
             for j in jobs:
                 steel = j["materials"]["M3-wet"]["interactions"]["steel"]
@@ -151,7 +151,7 @@ materials:
     stress = [12000, 24000, 40000, 60000, 86000]
 
     class Flaky:
-        def run(self, jobs):
+        def run(self, jobs, raise_on_error=True):
             steel = jobs[0]["materials"]["M3-wet"]["interactions"]["steel"]
             if steel["rolling_resistance_coefficient"] > 0.36:     # the rig blows up up there
                 raise RunError("wall_friction: RIG FAILED: blow-up")

@@ -21,6 +21,7 @@ echo run >> "$FAKE_COUNT"
 case "$FAKE_MODE" in
   ok) echo '{"bulk_density_kg_m3": 1600.0, "n_particles": 100}' > result.json ;;
   fail) echo "RIG FAILED: blow-up: particle 7 left the rig domain"; exit 3 ;;
+  refuse) echo "RIG FAILED: pile settle: no rest after 8 s" | tee rig_failure.txt; exit 3 ;;
   partial) echo '{"bulk' > result.json.part; exit 4 ;;
   sleep) sleep 5 ;;
 esac
@@ -62,6 +63,37 @@ def test_failure_keeps_log_and_writes_no_result(tmp_path, fake_yade, monkeypatch
     assert (failed / "yade.log").is_file() and not (failed / "result.json").exists()
     monkeypatch.setenv("FAKE_MODE", "ok")          # a later attempt runs again and succeeds
     assert runner.run_job(job, tmp_path / "runs")["n_particles"] == 100
+
+
+def test_a_rig_refusal_is_kept_and_not_simulated_again(tmp_path, fake_yade, monkeypatch):
+    """A RigFailure (rig_failure.txt) is the physics' verdict on this job: a resumed
+    study gets the same failure from the cache instead of paying for the run again."""
+    monkeypatch.setenv("FAKE_MODE", "refuse")
+    job = resolve_job("fill", "M2", seed=1)
+    for _ in range(2):
+        with pytest.raises(RunError, match="no rest after 8 s"):
+            runner.run_job(job, tmp_path / "runs")
+    pool = runner.LocalPool(tmp_path / "runs", workers=2, progress=False)
+    assert pool.run([job], raise_on_error=False) == [None]
+    assert "kept from an earlier run" in pool.last_errors[0] and pool.simulated_count == 0
+    assert fake_yade() == 1
+
+
+def test_jobio_writes_the_refusal_file(tmp_path):
+    """yade_scripts/demlib/jobio.run_rig on a RigFailure: exit 3, no result.json, and
+    rig_failure.txt naming the reason (plain python: the rig body is not YADE here)."""
+    import subprocess
+    import sys
+    from pycal import SCRIPT_DIR
+    (tmp_path / "job.json").write_text(json.dumps({"rig": "fill", "material": "M2", "seed": 1}))
+    code = ("import sys; sys.path.insert(0, %r)\n"
+            "from demlib.jobio import run_rig, RigFailure\n"
+            "def main(job, out):\n    raise RigFailure('no rest after 8 s')\n"
+            "run_rig(main)\n") % str(SCRIPT_DIR)
+    proc = subprocess.run([sys.executable, "-c", code, str(tmp_path / "job.json")], capture_output=True, text=True)
+    assert proc.returncode == 3 and "RIG FAILED: no rest after 8 s" in proc.stdout
+    assert (tmp_path / runner.RIG_FAILURE_FILE).read_text().strip() == "RIG FAILED: no rest after 8 s"
+    assert not (tmp_path / "result.json").exists()
 
 
 def test_half_written_result_is_not_a_result(tmp_path, fake_yade, monkeypatch):

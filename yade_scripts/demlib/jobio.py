@@ -19,6 +19,9 @@ _T0 = time.time()
 _STARTED = datetime.datetime.now(datetime.timezone.utc).isoformat(timespec="seconds")
 
 
+RIG_FAILURE_FILE = "rig_failure.txt"   # written instead of result.json when the rig itself refuses a run
+
+
 class RigFailure(Exception):
     """The rig cannot give a valid result (blow-up, escape, no rest...)."""
 
@@ -123,12 +126,17 @@ def write_result(out_dir, job, measurements):
 def run_rig(main):
     """Run main(job, out_dir) -> measurements dict; on any failure print one clear line
     'RIG FAILED: ...', write no result.json and exit non-zero."""
+    out_dir = None
     try:
         job, out_dir = load_job()
         measurements = main(job, out_dir)
         write_result(out_dir, job, measurements)
     except RigFailure as exc:
         print(f"RIG FAILED: {exc}", flush=True)
+        if out_dir:
+            # the physics' verdict on this job (same job, same seed: same failure); the
+            # runner keeps it so that the job is not simulated again
+            _atomic_write(os.path.join(out_dir, RIG_FAILURE_FILE), f"RIG FAILED: {exc}\n")
         sys.stdout.flush()
         os._exit(3)
     except Exception as exc:
