@@ -35,6 +35,7 @@ from pycal.calibration.study import Study  # noqa: E402
 from pycal.jobs import resolve_job  # noqa: E402
 from pycal.post import mean_std  # noqa: E402
 from pycal.runner import LocalPool  # noqa: E402
+from run_bench import _git_commit  # noqa: E402  (bench/ is this script's folder)
 
 RESULTS = Path(__file__).resolve().parent / "results.jsonl"
 MATERIAL = "M2"
@@ -47,15 +48,19 @@ LIFT = {"rig.procedure.lift_speed_m_s": 0.01}
 WALL_STEPS = {"rig.procedure.consolidation_stresses_pa": [12000, 40000, 86000]}
 
 
-def hidden_overrides():
-    o = {k: v for k, v in HIDDEN.items() if k != "rolling_resistance"}
+def hidden_overrides(wall_friction=True):
+    """The hidden values as material overrides. Without the wall friction stage the
+    particle-steel friction is not hidden (it stays at the config's value on both sides):
+    a hidden value the study never moves would bias the fill, AoR and CCS targets."""
+    o = {k: v for k, v in HIDDEN.items() if k != "rolling_resistance"
+         and (wall_friction or k != "interactions.steel.friction_coefficient")}
     o.update({k: HIDDEN["rolling_resistance"] for k in ROLLING_KEYS})
     return o
 
 
 def simulate_targets(pool, seeds, lab, wall_friction=True):
     """Run the rigs with the hidden values; write the synthetic curves; return the scalar targets."""
-    o = hidden_overrides()
+    o = hidden_overrides(wall_friction)
 
     def run(rig, extra=None):
         return pool.run([resolve_job(rig, MATERIAL, {**o, **(extra or {})}, seed=s) for s in seeds])
@@ -70,13 +75,13 @@ def simulate_targets(pool, seeds, lab, wall_friction=True):
         for b, s, k in zip(r["branch"], r["target_stress_pa"], r["stiffness_pa"]):
             if b == "unloading" and k is not None:
                 rows.setdefault(float(s), []).append(k)
-    lines = ["# synthetic twin (bench/twin.py): unloading stiffness with hidden " + json.dumps(HIDDEN),
+    lines = ["# synthetic twin (bench/twin.py): unloading stiffness with hidden " + json.dumps(o),
              "stress_pa,particle_stiffness_pa,particle_stiffness_pa_low,particle_stiffness_pa_high,provenance"]
     for s in sorted(rows):
         m = mean_std(rows[s])[0]
         lines.append(f"{s:.0f},{m:.6g},{0.7 * m:.6g},{1.3 * m:.6g},synthetic")
     (lab / "curves" / "ccs_expansion_gravel_dry.csv").write_text("\n".join(lines) + "\n")
-    lines = ["# synthetic twin (bench/twin.py): wall friction with hidden " + json.dumps(HIDDEN),
+    lines = ["# synthetic twin (bench/twin.py): wall friction with hidden " + json.dumps(o),
              "stress_pa,mu_static,mu_static_low,mu_static_high,mu_dynamic,mu_dynamic_low,mu_dynamic_high,provenance"]
     for k, s in enumerate(wall[0]["stress_pa"] if wall else []):
         ms = mean_std([r["mu_static"][k] for r in wall if r["mu_static"][k] is not None])[0]
@@ -147,8 +152,8 @@ def main(argv=None):
     out.mkdir(parents=True, exist_ok=True)
     pool = LocalPool(out / "runs", workers=args.workers, timeout_s=3600)
     t0 = time.time()
-    print(f"twin: simulating the targets with the hidden values {HIDDEN}", flush=True)
     wall = not args.without_wall_friction
+    print(f"twin: simulating the targets with the hidden values {hidden_overrides(wall)}", flush=True)
     targets = simulate_targets(pool, list(range(101, 101 + args.seeds_count)), out / "twin_lab", wall)
     t_targets = time.time() - t0
     print(f"twin: targets {targets} ({t_targets:.0f} s)", flush=True)
@@ -171,6 +176,7 @@ def main(argv=None):
                "runs_requested": study.runs_requested, "seeds_count": args.seeds_count,
                "wall_s_targets": round(t_targets, 1), "wall_s_calibration": round(t_cal, 1),
                "workers": pool.workers if hasattr(pool, "workers") else args.workers, "host": platform.node(),
+               "git_commit": _git_commit(),
                "date_utc": datetime.datetime.now(datetime.timezone.utc).isoformat(timespec="seconds")}
     (out / "twin.json").write_text(json.dumps(summary, indent=1, default=str))
     with open(RESULTS, "a") as f:
