@@ -87,3 +87,20 @@ def test_cached_rerun_replays_the_same_jobs(tmp_path):
     fit_density("M2", executor=b, progress=None)
     ids = lambda f: [[j["job_id"] for j in call] for call in f.calls]
     assert ids(a) == ids(b)                      # same job hashes -> a resumed calibration hits the cache
+
+
+def test_a_miss_inside_the_seed_noise_is_met_and_says_so(tmp_path):
+    """Fill noise (std 5 % over 3 seeds: 2 standard errors ~6 %) larger than the 1 %
+    tolerance, and every iteration lands 2-3 % off: the verdict is met within the noise,
+    never tighter than the seed spread; the same 2.5 % miss with quiet seeds is not met."""
+    class Jumpy(FakeFill):
+        def run(self, jobs, raise_on_error=True):
+            spread = {1: -0.05, 2: 0.0, 3: 0.05} if self.noise else {1: 0.0, 2: 0.0, 3: 0.0}
+            return [{"bulk_density_kg_m3": 1603.0 * 1.025 * (1 + spread[j["seed"]]),
+                     "solid_fraction": 0.4, "n_particles": 70} for j in jobs]
+    fit = fit_density("M2", seeds=3, max_iterations=2, executor=Jumpy(noise=1), out_dir=tmp_path, progress=None)
+    assert fit.tolerance_met and "within the seed noise" in fit.message
+    with pytest.warns(UserWarning, match="NOT CONVERGED"):
+        fit = fit_density("M2", seeds=3, max_iterations=2, executor=Jumpy(noise=0), out_dir=tmp_path,
+                          progress=None)
+    assert not fit.tolerance_met
