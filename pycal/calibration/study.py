@@ -416,6 +416,14 @@ class Study:
             self.overrides[material][k] = row["value"]
         return row_out
 
+    @staticmethod
+    def _stage_target(st):
+        """The stage's target value for the tables (NaN where it has none or it cannot be read)."""
+        try:
+            return lab_target(st["target"]) if "target" in st else math.nan
+        except Exception:      # noqa: BLE001 - a table entry, never a reason to stop
+            return math.nan
+
     def run(self):
         stage_fn = {"density": self.stage_density, "rolling_resistance": self.stage_monotone,
                     "cohesion": self.stage_monotone, "stiffness": self.stage_monotone,
@@ -437,7 +445,8 @@ class Study:
                     # study goes on with the values found so far
                     row = {"parameter": "+".join(st.get("parameter", {}).get("keys", [])), "value": math.nan,
                            "response": st.get("response", ""), "response_mean": math.nan,
-                           "response_std": math.nan, "target": math.nan, "tolerance": math.nan,
+                           "response_std": math.nan, "target": self._stage_target(st),
+                           "tolerance": next((st[k] for k in TOLERANCE_KEYS if k in st), math.nan),
                            "met": False, "message": f"runs failed: {exc}", "evaluations": 0}
                 row.update({"material": material, "stage": stage_label(st), "kind": st["stage"],
                             "runs_requested": self.runs_requested - runs_before,

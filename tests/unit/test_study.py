@@ -194,6 +194,8 @@ def test_a_stage_whose_runs_fail_is_not_met_and_the_study_goes_on(tmp_path, stud
     assert by[("M3-dry", "density")]["met"]
     assert not by[("M3-dry", "rolling_resistance")]["met"]
     assert "blow-up" in by[("M3-dry", "rolling_resistance")]["message"]
+    assert by[("M3-dry", "rolling_resistance")]["tolerance"] == 0.5       # the table still names the target
+    assert math.isfinite(by[("M3-dry", "rolling_resistance")]["target"])
     assert not by[("M3-wet", "inherit")]["met"] and "found no value" in by[("M3-wet", "inherit")]["message"]
     assert ("M3-wet", "cohesion") in by          # the study went on
 
