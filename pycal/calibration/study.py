@@ -275,7 +275,8 @@ class Study:
                              tol, max_evaluations=st.get("max_iterations_count", 6),
                              increasing=p.get("response_increases"),
                              first_step=math.log(4.0) if log else None,
-                             slope_estimate=p.get("response_slope_estimate"))
+                             slope_estimate=p.get("response_slope_estimate"),
+                             show=lambda u: f"{to_x(u):.4g}")
         value = to_x(sol.x)
         for k in p["keys"]:
             self.overrides[material][k] = value

@@ -81,3 +81,43 @@ def test_slope_estimate_gives_a_newton_second_point():
                          increasing=True, slope_estimate=1.0)
     assert seen[1] == pytest.approx(0.5 + 0.085)
     assert sol.met and len(sol.history) == 2
+
+
+def stiffness_rig(refuse_above_pa, seen):
+    """M3-dry as measured: the CCS-expansion log ratio rises 0.38 per unit of ln E and
+    reaches 0 near E = 2e8 Pa; the rig cannot hold its load above `refuse_above_pa`."""
+    from pycal.errors import RunError
+
+    def evaluate(u):
+        seen.append(math.exp(u))
+        if math.exp(u) > refuse_above_pa:
+            raise RunError("load to 3000 Pa: not reached at rest after 8 s")
+        return 0.38 * (u - math.log(2e8)), 0.04, 3
+    return evaluate
+
+
+def test_a_refused_point_backs_off_towards_the_last_point_that_ran():
+    seen = []
+    sol = solve_monotone(stiffness_rig(3e8, seen), target=0.0, x0=math.log(6e6), lo=math.log(1e6),
+                         hi=math.log(1e9), tolerance=0.25, first_step=math.log(4.0), increasing=True,
+                         show=lambda u: f"{math.exp(u):.3g}")
+    assert any(e > 3e8 for e in seen), "the secant step should overshoot into the refused range"
+    assert sol.met and 6e7 < math.exp(sol.x) <= 3e8
+    assert all(p.x <= math.log(3e8) for p in sol.history)
+
+
+def test_refusals_until_the_budget_ends_keep_the_best_point_that_ran():
+    seen = []
+    sol = solve_monotone(stiffness_rig(3e7, seen), target=0.0, x0=math.log(6e6), lo=math.log(1e6),
+                         hi=math.log(1e9), tolerance=0.25, first_step=math.log(4.0), increasing=True,
+                         max_evaluations=4, show=lambda u: f"{math.exp(u):.3g}")
+    assert len(seen) == 4 and not sol.met
+    assert math.exp(sol.x) == pytest.approx(max(e for e in seen if e <= 3e7))
+    assert "the rig refused" in sol.message and "not reached at rest" in sol.message
+
+
+def test_a_refused_start_point_raises():
+    from pycal.errors import RunError
+    with pytest.raises(RunError):
+        solve_monotone(stiffness_rig(1e6, []), target=0.0, x0=math.log(6e6), lo=math.log(1e6),
+                       hi=math.log(1e9), tolerance=0.25, increasing=True)
