@@ -80,10 +80,11 @@ def solve_monotone(evaluate, target, x0, lo, hi, tolerance, max_evaluations=6, f
         return len(history) + len(refused)
 
     def done(p, msg=""):
-        if refused and not abs(p.misfit(target)) <= effective_tolerance(p, tolerance):
+        met = abs(p.misfit(target)) <= effective_tolerance(p, tolerance)
+        if refused and not met:
             msg = (msg + "; " if msg else "") + "the rig refused " + ", ".join(
                 show(x) for x, _ in refused) + f" ({refused[0][1][:160]})"
-        return Solution(p.x, p, abs(p.misfit(target)) <= effective_tolerance(p, tolerance), history, msg)
+        return Solution(p.x, p, met, history, msg)
 
     def step_to(end, x):
         """x, or halfway from `end` (a point that ran) to the nearest refused point beyond
