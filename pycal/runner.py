@@ -23,6 +23,7 @@ from pathlib import Path
 
 from . import REPO_ROOT, SCRIPT_DIR
 from .errors import RunError
+from .rig_contract import JOB_FILE, LOG_FILE, RESULT_FILE, RIG_FAILURE_FILE
 
 YADE = os.environ.get("PYCAL_YADE", "yade")
 DEFAULT_RUNS_DIR = REPO_ROOT / "runs"
@@ -34,13 +35,12 @@ def job_dir(job, runs_dir):
 
 def cached_result(job, runs_dir):
     """The result of a complete job, or None."""
-    path = job_dir(job, runs_dir) / "result.json"
+    path = job_dir(job, runs_dir) / RESULT_FILE
     if path.is_file():
         return json.loads(path.read_text())
     return None
 
 
-RIG_FAILURE_FILE = "rig_failure.txt"     # yade_scripts/demlib/jobio.py writes it on RigFailure
 
 
 def cached_failure(job, runs_dir):
@@ -49,7 +49,7 @@ def cached_failure(job, runs_dir):
     path = failed / RIG_FAILURE_FILE
     if path.is_file():
         return (f"{job['job_id']}: no result ({path.read_text().strip()}; kept from an earlier run: "
-                f"delete {failed} to run it again); log: {failed / 'yade.log'}")
+                f"delete {failed} to run it again); log: {failed / LOG_FILE}")
     return None
 
 
@@ -65,23 +65,23 @@ def _prepare(job, runs_dir):
     if tmp.exists():
         shutil.rmtree(tmp)
     tmp.mkdir(parents=True)
-    _write_json_atomic(tmp / "job.json", job)
+    _write_json_atomic(tmp / JOB_FILE, job)
     return tmp, final
 
 
 def _finish(tmp, final, log_tail):
     """Move a run folder into place if it wrote result.json; else keep it as .failed."""
-    if (tmp / "result.json").is_file():
+    if (tmp / RESULT_FILE).is_file():
         if final.exists():           # finished concurrently by another process: keep theirs
             shutil.rmtree(tmp)
         else:
             os.replace(tmp, final)
-        return json.loads((final / "result.json").read_text())
+        return json.loads((final / RESULT_FILE).read_text())
     failed = final.parent / f"{final.name}.failed"
     if failed.exists():
         shutil.rmtree(failed)
     os.replace(tmp, failed)
-    raise RunError(f"{final.name}: no result ({log_tail}); log: {failed / 'yade.log'}")
+    raise RunError(f"{final.name}: no result ({log_tail}); log: {failed / LOG_FILE}")
 
 
 def _log_tail(log_path, n=3):
@@ -91,6 +91,13 @@ def _log_tail(log_path, n=3):
         return "no log"
     errors = [l for l in lines if "RIG FAILED" in l or "Error" in l]
     return " | ".join((errors or lines)[-n:])
+
+
+def yade_env():
+    """Environment of a YADE run: one thread (bit-reproducible) and the repo root on
+    PYTHONPATH (rig scripts import `yade_scripts.demlib` and `pycal` as packages)."""
+    path = os.pathsep.join([str(REPO_ROOT)] + [p for p in os.environ.get("PYTHONPATH", "").split(os.pathsep) if p])
+    return dict(os.environ, OMP_NUM_THREADS="1", PYTHONPATH=path)
 
 
 def yade_command(script, job_file):
@@ -110,10 +117,10 @@ def run_job(job, runs_dir=DEFAULT_RUNS_DIR, timeout_s=3600):
     if not script.is_file():
         raise RunError(f"{job['rig']}: rig script {script} does not exist")
     tmp, final = _prepare(job, runs_dir)
-    env = dict(os.environ, OMP_NUM_THREADS="1", PYCAL_REPO=str(REPO_ROOT))
-    with open(tmp / "yade.log", "w") as log:
+    env = yade_env()
+    with open(tmp / LOG_FILE, "w") as log:
         try:
-            proc = subprocess.run(yade_command(script, tmp / "job.json"), cwd=tmp, env=env,
+            proc = subprocess.run(yade_command(script, tmp / JOB_FILE), cwd=tmp, env=env,
                                   stdout=log, stderr=subprocess.STDOUT, stdin=subprocess.DEVNULL,
                                   timeout=timeout_s)
             rc = proc.returncode
@@ -123,10 +130,10 @@ def run_job(job, runs_dir=DEFAULT_RUNS_DIR, timeout_s=3600):
             shutil.rmtree(tmp)
             raise RunError(f"'{YADE}' not found: install YADE (./run.sh installs it)") from None
     if rc != 0:
-        (tmp / "result.json").unlink(missing_ok=True)
-        tail = f"timeout after {timeout_s} s" if rc == "timeout" else f"exit code {rc}: {_log_tail(tmp / 'yade.log')}"
+        (tmp / RESULT_FILE).unlink(missing_ok=True)
+        tail = f"timeout after {timeout_s} s" if rc == "timeout" else f"exit code {rc}: {_log_tail(tmp / LOG_FILE)}"
         return _finish(tmp, final, tail)
-    return _finish(tmp, final, _log_tail(tmp / "yade.log"))
+    return _finish(tmp, final, _log_tail(tmp / LOG_FILE))
 
 
 class LocalPool:
@@ -203,7 +210,7 @@ class YadeBatch:
         for script, idx in by_script.items():
             dirs = {i: _prepare(jobs[i], self.runs_dir) for i in idx}
             table = self.runs_dir / f".batch-{os.getpid()}-{Path(script).stem}.table"
-            write_batch_table(table, [(jobs[i]["job_id"], dirs[i][0] / "job.json") for i in idx])
+            write_batch_table(table, [(jobs[i]["job_id"], dirs[i][0] / JOB_FILE) for i in idx])
             cmd = [YADE + "-batch", "-j", str(self.workers), "--job-threads", "1",
                    "--log", str(self.runs_dir / ".batch-logs" / "$.log"), "--disable-pynotify",
                    str(table), str(SCRIPT_DIR / script)]
@@ -213,14 +220,14 @@ class YadeBatch:
             subprocess.run(cmd, cwd=self.runs_dir, stdout=subprocess.DEVNULL,
                            stderr=subprocess.DEVNULL, stdin=subprocess.DEVNULL,
                            timeout=self.timeout_s * max(1, len(idx)),
-                           env=dict(os.environ, OMP_NUM_THREADS="1", PYCAL_REPO=str(REPO_ROOT)))
+                           env=yade_env())
             for i in idx:
                 tmp, final = dirs[i]
                 blog = self.runs_dir / ".batch-logs" / f"{jobs[i]['job_id']}.log"
                 if blog.is_file():
-                    shutil.copy(blog, tmp / "yade.log")
+                    shutil.copy(blog, tmp / LOG_FILE)
                 try:
-                    results[i] = _finish(tmp, final, _log_tail(tmp / "yade.log"))
+                    results[i] = _finish(tmp, final, _log_tail(tmp / LOG_FILE))
                 except RunError as exc:
                     errors.append(str(exc))
             table.unlink(missing_ok=True)

@@ -11,12 +11,9 @@ Run: yade -j1 -x -n yade_scripts/aor.py job.json
 import os
 import sys
 
-_HERE = os.path.dirname(os.path.abspath(sys.argv[0]))  # yade -x: __file__ is not the script
-sys.path.insert(0, _HERE)
-sys.path.insert(0, os.path.dirname(_HERE))             # repo root: pycal.post.aor (no yade inside)
-from demlib.jobio import run_rig  # noqa: E402
-from demlib.scene import Scene  # noqa: E402
-from demlib import rigs  # noqa: E402
+from yade_scripts.demlib.jobio import run_rig
+from yade_scripts.demlib.scene import Scene
+from yade_scripts.demlib import rigs
 
 
 def build_pile(scene):

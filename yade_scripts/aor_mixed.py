@@ -15,11 +15,8 @@ Run: yade -j1 -x -n yade_scripts/aor_mixed.py job.json
 import os
 import sys
 
-_HERE = os.path.dirname(os.path.abspath(sys.argv[0]))  # yade -x: __file__ is not the script
-sys.path.insert(0, _HERE)
-sys.path.insert(0, os.path.dirname(_HERE))             # repo root: pycal.post (no yade inside)
-from demlib.jobio import run_rig, write_csv  # noqa: E402
-from demlib import mixed, rigs  # noqa: E402
+from yade_scripts.demlib.jobio import run_rig, write_csv
+from yade_scripts.demlib import mixed, rigs
 
 
 def build_pile(scene):

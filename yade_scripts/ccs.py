@@ -16,12 +16,9 @@ step_tolerance_ratio of the target and the bulk is at rest, and record the step.
 Outputs: result.json (per-step arrays), spring_curve.csv, lab_comparison.csv, PNGs.
 Run: yade -j1 -x -n yade_scripts/ccs.py job.json
 """
-import os
-import sys
 
-sys.path.insert(0, os.path.dirname(os.path.abspath(sys.argv[0])))  # yade -x: __file__ is not the script
-from demlib.jobio import run_rig  # noqa: E402
-from demlib import compression  # noqa: E402
+from yade_scripts.demlib.jobio import run_rig
+from yade_scripts.demlib import compression
 
 
 def main(job, out_dir):

@@ -9,12 +9,9 @@ last loading point): result.json `unloading_stiffness_pa` (and `unloading_stress
 the stress each belongs to), besides the per-step arrays of every step.
 Run: yade -j1 -x -n yade_scripts/ccs_expansion.py job.json
 """
-import os
-import sys
 
-sys.path.insert(0, os.path.dirname(os.path.abspath(sys.argv[0])))  # yade -x: __file__ is not the script
-from demlib.jobio import run_rig, RigFailure  # noqa: E402
-from demlib import compression  # noqa: E402
+from yade_scripts.demlib.jobio import run_rig, RigFailure
+from yade_scripts.demlib import compression
 
 
 def main(job, out_dir):

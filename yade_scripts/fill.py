@@ -5,13 +5,10 @@ particles whose centre is above the rim are removed (configs/rigs/fill.yaml).
 Run: yade -j1 -x -n yade_scripts/fill.py job.json
 """
 import math
-import os
-import sys
 
-sys.path.insert(0, os.path.dirname(os.path.abspath(sys.argv[0])))  # yade -x: __file__ is not the script
-from demlib.jobio import run_rig  # noqa: E402
-from demlib.scene import Scene  # noqa: E402
-from demlib import rigs  # noqa: E402
+from yade_scripts.demlib.jobio import run_rig
+from yade_scripts.demlib.scene import Scene
+from yade_scripts.demlib import rigs
 
 
 def main(job, out_dir):

@@ -14,12 +14,9 @@ There is no plate force here: only tan(angle) is recorded.
 Run: yade -j1 -x -n yade_scripts/internal_friction.py job.json
 """
 import math
-import os
-import sys
 
-sys.path.insert(0, os.path.dirname(os.path.abspath(sys.argv[0])))  # yade -x: __file__ is not the script
-from demlib.jobio import run_rig  # noqa: E402
-from demlib import tilt as tl  # noqa: E402
+from yade_scripts.demlib.jobio import run_rig
+from yade_scripts.demlib import tilt as tl
 
 
 def build(scene):

@@ -7,16 +7,11 @@ vibration_duration_s, stop at their home position, the pile settles and is measu
 again (surcharge_* keys, surcharge_*.csv, surcharge_side.png).
 Run: yade -j1 -x -n yade_scripts/surcharge.py job.json
 """
-import os
-import sys
 
-_HERE = os.path.dirname(os.path.abspath(sys.argv[0]))  # yade -x: __file__ is not the script
-sys.path.insert(0, _HERE)
-sys.path.insert(0, os.path.dirname(_HERE))
-from demlib.jobio import run_rig  # noqa: E402
-from demlib.scene import Scene  # noqa: E402
-from demlib import rigs  # noqa: E402
-import aor  # noqa: E402  (its run_rig only runs when aor.py is the script)
+from yade_scripts.demlib.jobio import run_rig
+from yade_scripts.demlib.scene import Scene
+from yade_scripts.demlib import rigs
+from yade_scripts import aor
 
 
 def main(job, out_dir):

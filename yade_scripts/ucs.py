@@ -23,13 +23,10 @@ Outputs: result.json (per-step arrays), spring_curve.csv, lab_comparison.csv, PN
 Run: yade -j1 -x -n yade_scripts/ucs.py job.json
 """
 import math
-import os
-import sys
 
-sys.path.insert(0, os.path.dirname(os.path.abspath(sys.argv[0])))  # yade -x: __file__ is not the script
-from demlib.jobio import run_rig, OverlapLimitExceeded  # noqa: E402
-from demlib.scene import Scene  # noqa: E402
-from demlib import rigs, loading, compression  # noqa: E402
+from yade_scripts.demlib.jobio import run_rig, OverlapLimitExceeded
+from yade_scripts.demlib.scene import Scene
+from yade_scripts.demlib import rigs, loading, compression
 
 PLATE_SEGMENTS = 32   # polygon of the circular plate (equal area: the stress area is exact)
 

@@ -84,13 +84,12 @@ def test_jobio_writes_the_refusal_file(tmp_path):
     rig_failure.txt naming the reason (plain python: the rig body is not YADE here)."""
     import subprocess
     import sys
-    from pycal import SCRIPT_DIR
     (tmp_path / "job.json").write_text(json.dumps({"rig": "fill", "material": "M2", "seed": 1}))
-    code = ("import sys; sys.path.insert(0, %r)\n"
-            "from demlib.jobio import run_rig, RigFailure\n"
+    code = ("from yade_scripts.demlib.jobio import run_rig, RigFailure\n"
             "def main(job, out):\n    raise RigFailure('no rest after 8 s')\n"
-            "run_rig(main)\n") % str(SCRIPT_DIR)
-    proc = subprocess.run([sys.executable, "-c", code, str(tmp_path / "job.json")], capture_output=True, text=True)
+            "run_rig(main)\n")
+    proc = subprocess.run([sys.executable, "-c", code, str(tmp_path / "job.json")], capture_output=True, text=True,
+                          env=runner.yade_env())
     assert proc.returncode == 3 and "RIG FAILED: no rest after 8 s" in proc.stdout
     assert (tmp_path / runner.RIG_FAILURE_FILE).read_text().strip() == "RIG FAILED: no rest after 8 s"
     assert not (tmp_path / "result.json").exists()

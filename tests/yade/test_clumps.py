@@ -22,18 +22,16 @@ import os
 import random
 import shutil
 import subprocess
-import sys
 from pathlib import Path
 
 import numpy as np
 import pytest
 
 from pycal.jobs import resolve_job
-from pycal.runner import run_job
+from pycal.runner import run_job, yade_env
 
 ROOT = Path(__file__).resolve().parents[2]
-sys.path.insert(0, str(ROOT / "yade_scripts"))
-from demlib import clumps, mixed  # noqa: E402  (pure-Python parts: numpy only)
+from yade_scripts.demlib import clumps, mixed  # pure-Python parts: numpy only
 
 pytestmark = [pytest.mark.yade,
               pytest.mark.skipif(shutil.which("yade") is None, reason="YADE is not installed")]
@@ -44,7 +42,6 @@ SIZE = 0.04
 
 HEADER = f"""
 import json, os, sys
-sys.path.insert(0, {str(ROOT / 'yade_scripts')!r}); sys.path.insert(0, {str(ROOT)!r})
 from yade import O, utils
 def done(data):
     print("JSON " + json.dumps(data), flush=True)
@@ -59,7 +56,7 @@ def run_yade(tmp_path, body, job, timeout=300):
     (d / "job.json").write_text(json.dumps(job))
     (d / "scene.py").write_text(HEADER + body)
     proc = subprocess.run(["yade", "-j1", "-x", "-n", "scene.py", "job.json"], cwd=d, capture_output=True,
-                          text=True, timeout=timeout, env={**os.environ, "OMP_NUM_THREADS": "1"})
+                          text=True, timeout=timeout, env=yade_env())
     lines = [l for l in proc.stdout.splitlines() if l.startswith("JSON ")]
     assert proc.returncode == 0 and lines, f"scene failed:\n{proc.stdout[-3000:]}\n{proc.stderr[-3000:]}"
     return json.loads(lines[-1][5:])
@@ -107,7 +104,7 @@ def test_lump_geometry_follows_the_stated_rule():
 CLUMP_SCENE = """
 import numpy as np, random
 from yade.wrapper import CohFrictMat
-from demlib import clumps
+from yade_scripts.demlib import clumps
 mat = O.materials.append(CohFrictMat(density=2750, young=6e6))
 shapes = job["materials"]["M1"]["particles"]["shapes"]
 rng = random.Random(7)
@@ -165,7 +162,7 @@ def test_clump_mass_and_inertia(yade_clumps, shape):
 SLAB_SCENE = """
 import math, random
 import numpy as np
-from demlib import clumps, mixed
+from yade_scripts.demlib import clumps, mixed
 sc = mixed.MixedScene(job)
 sc.add_table(0.3, "steel")
 sc.set_domain((-0.3, -0.3, -0.05), (0.3, 0.3, 0.3))
@@ -251,7 +248,7 @@ def test_same_seed_same_fill_other_seed_other_fill():
 
 
 FILL_SCENE = """
-from demlib import mixed
+from yade_scripts.demlib import mixed
 sc = mixed.MixedScene(job)
 gen = mixed.generate(job)
 g = job["rig_config"]["geometry"]

@@ -15,7 +15,7 @@ import pytest
 
 from pycal.errors import RunError
 from pycal.jobs import resolve_job
-from pycal.runner import run_job, job_dir
+from pycal.runner import run_job, job_dir, yade_env
 
 pytestmark = [pytest.mark.yade,
               pytest.mark.skipif(shutil.which("yade") is None, reason="YADE is not installed")]
@@ -33,7 +33,7 @@ def run_scene(tmp_path, scene, overrides, params, material="M2", timeout=120):
     (d / "job.json").write_text(json.dumps(job))
     proc = subprocess.run(["yade", "-j1", "-x", "-n", str(SCENES / f"{scene}.py"), "job.json"],
                           cwd=d, capture_output=True, text=True, timeout=timeout,
-                          env={**os.environ, "OMP_NUM_THREADS": "1"})
+                          env=yade_env())
     out = d / "measurements.json"
     assert proc.returncode == 0 and out.is_file(), f"{scene} failed:\n{proc.stdout[-2000:]}\n{proc.stderr[-2000:]}"
     return json.loads(out.read_text())

@@ -43,7 +43,7 @@ import pytest
 
 from pycal import REPO_ROOT
 from pycal.jobs import resolve_job
-from pycal.runner import run_job
+from pycal.runner import run_job, yade_env
 
 pytestmark = [pytest.mark.yade,
               pytest.mark.skipif(shutil.which("yade") is None, reason="yade is not installed")]
@@ -119,9 +119,8 @@ PAIR_SCENE = textwrap.dedent('''
     """Two spheres: A fixed, B hanging below it by a fresh bond (contact.py family of
     the job); optionally B is first pressed up against A with press_weights x its weight."""
     import json, os, sys
-    sys.path.insert(0, os.path.join(sys.argv[2], "yade_scripts"))
     from yade import O, utils, Vector3
-    from demlib.scene import Scene
+    from yade_scripts.demlib.scene import Scene
 
     def case(job, press):
         sc = Scene(job)
@@ -157,7 +156,7 @@ def run_pair_scene(d, cases):
     (d / "cases.json").write_text(json.dumps({"cases": cases}))
     (d / "pair.py").write_text(PAIR_SCENE)
     proc = subprocess.run(["yade", "-j1", "-x", "-n", "pair.py", "cases.json", str(REPO_ROOT)], cwd=d,
-                          capture_output=True, text=True, timeout=300, env={**os.environ, "OMP_NUM_THREADS": "1"})
+                          capture_output=True, text=True, timeout=300, env=yade_env())
     out = d / "pair.json"
     assert proc.returncode == 0 and out.is_file(), proc.stdout[-2000:] + proc.stderr[-2000:]
     return json.loads(out.read_text())

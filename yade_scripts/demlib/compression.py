@@ -4,7 +4,6 @@ CSV/PNG outputs come from pycal.post.compression (pure Python).
 """
 import math
 import os
-import sys
 
 from yade import O
 
@@ -12,10 +11,7 @@ from . import loading, rigs
 from .scene import Scene
 from .jobio import RigFailure
 
-_REPO = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
-if _REPO not in sys.path:
-    sys.path.insert(0, _REPO)
-from pycal.post import compression as post  # noqa: E402  (pure Python, no YADE)
+from pycal.post import compression as post  # pure Python, no YADE
 
 
 def vertical_force(ids):

@@ -19,7 +19,7 @@ _T0 = time.time()
 _STARTED = datetime.datetime.now(datetime.timezone.utc).isoformat(timespec="seconds")
 
 
-RIG_FAILURE_FILE = "rig_failure.txt"   # written instead of result.json when the rig itself refuses a run
+from pycal.rig_contract import RESULT_FILE, RIG_FAILURE_FILE, EXIT_RIG_FAILURE, EXIT_ERROR, EXIT_OK
 
 
 class RigFailure(Exception):
@@ -57,7 +57,8 @@ def load_job():
 
 
 def _git(*args):
-    repo = os.environ.get("PYCAL_REPO") or os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+    from pycal import REPO_ROOT
+    repo = str(REPO_ROOT)
     try:
         return subprocess.run(["git", "-C", repo] + list(args), capture_output=True, text=True,
                               timeout=10).stdout.strip()
@@ -118,8 +119,8 @@ def write_result(out_dir, job, measurements):
     result.update({"job_id": job.get("job_id"), "rig": job["rig"], "material": job["material"],
                    "seed": job["seed"], "job": job, "provenance": provenance()})
     text = json.dumps(result, indent=1, sort_keys=True, allow_nan=False)
-    _atomic_write(os.path.join(out_dir, "result.json"), text)
-    print("RESULT written:", os.path.join(out_dir, "result.json"), flush=True)
+    _atomic_write(os.path.join(out_dir, RESULT_FILE), text)
+    print("RESULT written:", os.path.join(out_dir, RESULT_FILE), flush=True)
     return result
 
 
@@ -138,11 +139,11 @@ def run_rig(main):
             # runner keeps it so that the job is not simulated again
             _atomic_write(os.path.join(out_dir, RIG_FAILURE_FILE), f"RIG FAILED: {exc}\n")
         sys.stdout.flush()
-        os._exit(3)
+        os._exit(EXIT_RIG_FAILURE)
     except Exception as exc:
         traceback.print_exc()
         print(f"RIG FAILED: {type(exc).__name__}: {exc}", flush=True)
-        os._exit(4)
+        os._exit(EXIT_ERROR)
     sys.stdout.flush()
     sys.stderr.flush()
-    os._exit(0)
+    os._exit(EXIT_OK)

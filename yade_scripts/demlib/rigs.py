@@ -148,7 +148,7 @@ def vibrate_table(scene, table_ids, frequency, amp_x, amp_z, duration, updates_p
 
 
 def measure_pile(scene, out_dir, prefix="aor", files="pile", title=None):
-    """Measure the pile (pycal.post.aor; the rig script puts the repo root on sys.path),
+    """Measure the pile (pycal.post.aor; the repo root is on PYTHONPATH),
     write <files>_particles.csv, <files>_profile.csv and <files>_side.png.
     Returns (result keys {prefix_left_deg, ...}, full measurement dict)."""
     import os

@@ -20,19 +20,15 @@ Every number comes from the job (rig_config.geometry / procedure / numerics).
 """
 import math
 import os
-import sys
 
 from yade import O, utils, geom
 from yade import Vector3
 
 from .jobio import RigFailure
 
-_REPO = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
-if _REPO not in sys.path:
-    sys.path.insert(0, _REPO)
 
 DAMPING_MODES = ("damped", "undamped", "undamped_when_sliding")
-from pycal.post.friction import DYNAMIC_MAX_ANGLE_DEG  # noqa: E402  (pure Python, one rule for rig and post)
+from pycal.post.friction import DYNAMIC_MAX_ANGLE_DEG  # pure Python: one rule for rig and post
 
 
 # ------------------------------------------------------------------ geometry

@@ -9,7 +9,6 @@ import os
 import sys
 
 REPO = os.path.dirname(os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(sys.argv[0])))))
-sys.path.insert(0, os.path.join(REPO, "yade_scripts"))
 
 
 def load():

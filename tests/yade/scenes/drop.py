@@ -14,7 +14,7 @@ from yade import O, utils  # noqa: E402
 
 def main():
     job, p, out = _common.load()
-    from demlib.scene import Scene
+    from yade_scripts.demlib.scene import Scene
     sc = Scene(job)
     sc.add_table(0.1, "steel")
     r = sc.radius

@@ -13,7 +13,7 @@ from yade import O, utils, Vector3  # noqa: E402
 
 def main():
     job, p, out = _common.load()
-    from demlib.scene import Scene
+    from yade_scripts.demlib.scene import Scene
     sc = Scene(job)
     sc.add_table(0.5, "steel")
     r = sc.radius

@@ -15,8 +15,8 @@ from yade import O, utils  # noqa: E402
 
 def main():
     job, p, out = _common.load()
-    from demlib.scene import Scene
-    from demlib import contact
+    from yade_scripts.demlib.scene import Scene
+    from yade_scripts.demlib import contact
     sc = Scene(job)
     sc.add_table(0.6, "steel")
     r = sc.radius
