@@ -11,27 +11,8 @@ from pathlib import Path
 import yaml
 
 from . import CONFIG_DIR
+from .contact_rules import COHESION_MODELS, CONTACT_MODELS
 from .errors import ConfigError
-
-# Cohesion/adhesion models and their parameters (name -> (min, max) or None for no bound).
-# The YADE side (yade_scripts/demlib/contact_models.py) picks the contact-law family.
-COHESION_MODELS = {
-    "none": {},
-    # constant pull-off force = force_fraction x weight of the lighter particle,
-    # acting in contact and up to adhesive_distance_m beyond it
-    "force_fraction": {"force_fraction": (0.0, None), "adhesive_distance_m": (0.0, None)},
-    # Luding-type (demlib/contact_hysteretic.py): pull-off = force_fraction x weight of the
-    # lighter particle + pressure_fraction x the largest compressive force the contact has
-    # carried (sampled every update_interval_s of simulated time); acts in contact only
-    "hysteretic": {"force_fraction": (0.0, None), "pressure_fraction": (0.0, None),
-                   "update_interval_s": (1.0e-6, None)},
-    # Willett liquid bridge (demlib/contact_capillary.py; its own contact family: no rolling
-    # resistance, no other cohesion in the scene), material with itself only. Bridge volume
-    # = bridge_liquid_fraction x moisture x particle mass / water density x 2 / coordination_count;
-    # surface_tension_n_m is the stand-in's effective value (water 0.072 x R_stand-in / r_fines)
-    "liquid_bridge": {"surface_tension_n_m": (0.0, None), "contact_angle_deg": (0.0, 89.0),
-                      "bridge_liquid_fraction": (0.0, 1.0), "coordination_count": (1.0, None)},
-}
 
 # Suffixes that say a rig/numerics key's unit (SI) or that it is dimensionless.
 UNIT_SUFFIXES = ("_m", "_m_s", "_m_s2", "_s", "_pa", "_n", "_kg", "_kg_m3", "_deg", "_deg_s",
@@ -156,10 +137,9 @@ def validate_material(data, path, partners):
     else:
         _validate_clump_particles(c, p)
     k = data["contact"]
-    c.keys(k, "contact", ["youngs_modulus_pa", "poisson_ratio", "restitution"])
+    c.keys(k, "contact", ["youngs_modulus_pa", "poisson_ratio"])
     c.number(k["youngs_modulus_pa"], "contact.youngs_modulus_pa", 0, lo_open=True)
     c.number(k["poisson_ratio"], "contact.poisson_ratio", -1, 0.5)
-    c.number(k["restitution"], "contact.restitution", 0.05, 1.0)
     inter = data["interactions"]
     if not isinstance(inter, dict):
         c.fail("interactions", "must be a mapping partner -> properties")
@@ -247,20 +227,32 @@ def check_rig_keys(data, c, key=""):
                 check_rig_keys(v, c, sub)
 
 
-# Numerics a rig may set that configs/numerics.yaml leaves at their default (the default
-# is what every rig does without the key): name -> (allowed values, default)
-OPTIONAL_NUMERICS = {
-    # rest check: kinetic energy of translation and rotation, or of translation only (a
-    # particle pinched between coincident facet vertices can spin in place for ever: the
-    # internal-friction rig's rims, measured 10 rad/s at 86 kPa with the bulk at rest)
-    "rest_kinetic_energy": (("total", "translational"), "total"),
+# Numerics keys whose value is a name: key -> allowed values
+NUMERICS_CHOICES = {
+    "contact_model": tuple(CONTACT_MODELS),
+    # rest check: kinetic energy of translation and rotation, or of translation only (a particle
+    # may spin in place on its elastic twisting spring with the bulk at rest: hertz_mindlin without
+    # global damping; a particle pinched between coincident facet vertices of the internal-friction
+    # rig's rims spun at 10 rad/s at 86 kPa under the first law)
+    "rest_kinetic_energy": ("total", "translational"),
 }
+
+
+def check_numerics_choices(numerics, c, prefix=""):
+    for k, allowed in NUMERICS_CHOICES.items():
+        if k in numerics:
+            c.string(numerics[k], prefix + k, list(allowed))
 
 
 def load_numerics(config_dir=CONFIG_DIR):
     path = Path(config_dir) / "numerics.yaml"
     data = load_yaml(path)
-    check_rig_keys(data, _Checker(path))
+    c = _Checker(path)
+    check_rig_keys(data, c)
+    for k in NUMERICS_CHOICES:
+        if k not in data:
+            c.fail(k, f"missing (one of {', '.join(NUMERICS_CHOICES[k])})")
+    check_numerics_choices(data, c)
     return data
 
 
@@ -292,12 +284,10 @@ def load_rig(name, config_dir=CONFIG_DIR):
         if k.endswith("_material") and v not in boundaries:
             c.fail(f"geometry.{k}", f"unknown boundary {v!r} (known: {', '.join(boundaries)})")
     numerics = load_numerics(config_dir)
-    for k, v in data.get("numerics", {}).items():
-        if k in OPTIONAL_NUMERICS:
-            if v not in OPTIONAL_NUMERICS[k][0]:
-                c.fail(f"numerics.{k}", f"{v!r} must be one of {', '.join(OPTIONAL_NUMERICS[k][0])}")
-        elif k not in numerics:
-            c.fail(f"numerics.{k}", f"unknown key (allowed: {', '.join(list(numerics) + list(OPTIONAL_NUMERICS))})")
+    for k in data.get("numerics", {}):
+        if k not in numerics:
+            c.fail(f"numerics.{k}", f"unknown key (allowed: {', '.join(numerics)})")
+    check_numerics_choices(data.get("numerics", {}), c, "numerics.")
     merged = copy.deepcopy(data)
     merged["numerics"] = {**numerics, **data.get("numerics", {})}
     return merged
@@ -318,22 +308,22 @@ def material_set_names(config_dir=CONFIG_DIR):
 
 
 def _check_pair_props(c, props, key):
-    """friction, rolling resistance and cohesion of one pair (as under `interactions:`)."""
-    c.keys(props, key, ["friction_coefficient", "rolling_resistance_coefficient", "cohesion"])
+    """friction, restitution, rolling resistance and cohesion of one pair (as under `interactions:`).
+    Whether the scene's contact law can realise them is checked per job (pycal.contact_rules)."""
+    c.keys(props, key, ["friction_coefficient", "restitution_coefficient", "rolling_resistance_coefficient",
+                        "cohesion"])
     c.number(props["friction_coefficient"], f"{key}.friction_coefficient", 0)
+    # below ~0.1 a DEM contact dashpot is close to critical and the solver may become unstable
+    c.number(props["restitution_coefficient"], f"{key}.restitution_coefficient", 0.05, 1.0)
     c.number(props["rolling_resistance_coefficient"], f"{key}.rolling_resistance_coefficient", 0)
     coh = props["cohesion"]
     if not isinstance(coh, dict) or "model" not in coh:
         c.fail(f"{key}.cohesion", "must be a mapping with a 'model' key")
     model = c.string(coh["model"], f"{key}.cohesion.model", list(COHESION_MODELS))
-    params = COHESION_MODELS[model]
+    params = COHESION_MODELS[model]["params"]
     c.keys(coh, f"{key}.cohesion", ["model"] + list(params))
     for pname, (lo, hi) in params.items():
         c.number(coh[pname], f"{key}.cohesion.{pname}", lo, hi)
-
-
-def _own_rolling(mat):
-    return float(mat["interactions"][mat["name"]]["rolling_resistance_coefficient"])
 
 
 def validate_material_set(data, path, materials):
@@ -397,21 +387,6 @@ def validate_material_set(data, path, materials):
                 c.fail(key, f"the pair {a} - {b} is listed twice")
             seen.add(pair)
             _check_pair_props(c, props, key)
-            # YADE's rolling law takes min(eta_a R_a, eta_b R_b): a pair can only have that value
-            ma, mb = materials[a], materials[b]
-            want = float(props["rolling_resistance_coefficient"])
-            if "clump" in (ma["particles"]["shape"], mb["particles"]["shape"]):
-                got = 0.0 if min(_own_rolling(m) for m in (ma, mb) if m["particles"]["shape"] == "clump") == 0 \
-                    else None
-                if got is None:
-                    c.fail(key, "clump materials take rolling resistance 0 (their member radii vary)")
-            else:
-                ra, rb = ma["particles"]["diameter_m"] / 2, mb["particles"]["diameter_m"] / 2
-                got = min(_own_rolling(ma) * ra, _own_rolling(mb) * rb) / min(ra, rb)
-            if abs(got - want) > 1e-9:
-                c.fail(f"{key}.rolling_resistance_coefficient",
-                       f"{want} cannot be realised: YADE uses min(eta_a R_a, eta_b R_b) of the two materials' "
-                       f"own coefficients, here {got:.4g}")
     names = list(comps)
     for i, a in enumerate(names):
         for b in names[i + 1:]:

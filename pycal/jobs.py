@@ -13,8 +13,9 @@ import yaml
 
 from . import CONFIG_DIR
 from .configs import (parse_yaml_text, load_boundaries_cached, load_material, load_rig, material_names,
-                      validate_material, check_rig_keys, _Checker)
+                      validate_material, check_rig_keys, check_numerics_choices, _Checker)
 from .configs import SET_DIR, load_yaml, material_set_names, rig_names, validate_material_set
+from .contact_rules import ContactRuleError, check_job
 from .errors import ConfigError
 
 JOB_FORMAT = 1
@@ -68,7 +69,9 @@ def resolve_job(rig, material, overrides=None, seed=1, config_dir=CONFIG_DIR):
             _set_path(mat, key, value, f"overrides of configs/materials/{material}.yaml")
     partners = set(material_names(config_dir)) | set(load_boundaries_cached(config_dir))
     validate_material(mat, f"configs/materials/{material}.yaml (with overrides)", partners)
-    check_rig_keys(rig_cfg, _Checker(f"configs/rigs/{rig}.yaml (with overrides)"))
+    rig_checker = _Checker(f"configs/rigs/{rig}.yaml (with overrides)")
+    check_rig_keys(rig_cfg, rig_checker)
+    check_numerics_choices(rig_cfg["numerics"], rig_checker, "numerics.")
     job = {
         "job_format": JOB_FORMAT,
         "rig": rig,
@@ -80,6 +83,7 @@ def resolve_job(rig, material, overrides=None, seed=1, config_dir=CONFIG_DIR):
         "rig_config": rig_cfg,
         "overrides": overrides,
     }
+    check_contacts(job)
     job["job_id"] = job_id(job)
     return job
 
@@ -120,7 +124,9 @@ def resolve_set_job(rig, set_name, overrides=None, seed=1, config_dir=CONFIG_DIR
         if m in known:
             validate_material(known[m], f"configs/materials/{m}.yaml (with overrides)", partners)
     mset = validate_material_set(raw, f"{set_path} (with overrides)" if overrides else set_path, known)
-    check_rig_keys(rig_cfg, _Checker(f"configs/rigs/{rig}.yaml (with overrides)"))
+    rig_checker = _Checker(f"configs/rigs/{rig}.yaml (with overrides)")
+    check_rig_keys(rig_cfg, rig_checker)
+    check_numerics_choices(rig_cfg["numerics"], rig_checker, "numerics.")
     materials = {m: known[m] for m in mset["components"]}
     for a, pairs in mset["cross_interactions"].items():
         for b, props in pairs.items():
@@ -138,7 +144,27 @@ def resolve_set_job(rig, set_name, overrides=None, seed=1, config_dir=CONFIG_DIR
         "rig_config": rig_cfg,
         "overrides": overrides,
     }
+    check_contacts(job)
     job["job_id"] = job_id(job)
+    return job
+
+
+def check_contacts(job):
+    """The job's contact law can realise every pair (pycal.contact_rules), else a ConfigError
+    naming the config file and key the value comes from."""
+    try:
+        check_job(job)
+    except ContactRuleError as exc:
+        parts = exc.key.split(".")
+        if parts[0] == "materials" and len(parts) > 2:
+            name = parts[1]
+            src = (f"configs/material_sets/{job['material']}.yaml or configs/materials/{name}.yaml"
+                   if "material_set" in job else f"configs/materials/{name}.yaml")
+            raise ConfigError(src, ".".join(parts[2:]), exc.reason) from None
+        if parts[0] == "rig_config":
+            raise ConfigError(f"configs/numerics.yaml or configs/rigs/{job['rig']}.yaml", ".".join(parts[2:]),
+                              exc.reason) from None
+        raise ConfigError(f"job {job['rig']}/{job['material']}", exc.key, exc.reason) from None
     return job
 
 

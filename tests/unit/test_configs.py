@@ -12,7 +12,7 @@ def test_shipped_configs_load():
     assert set(material_names()) == {"M1", "M2", "M3-dry", "M3-wet"}
     for m in material_names():
         mat = load_material(m)
-        assert mat["contact"]["youngs_modulus_pa"] == 6.0e6
+        assert mat["contact"]["youngs_modulus_pa"] == 2.0e7      # start value on the Hertz law (docs/contact-models.md)
     for r in rig_names():
         rig = load_rig(r)
         assert rig["geometry"]["cell_inner_diameter_m"] == pytest.approx(0.145)
@@ -27,7 +27,7 @@ def test_start_values_follow_the_method():
         mat = load_material(m)
         assert mat["particles"]["diameter_m"] == 0.025
         assert mat["particles"]["density_kg_m3"] == 2750
-        assert mat["contact"]["restitution"] == 0.3
+        assert all(p["restitution_coefficient"] == 0.3 for p in mat["interactions"].values())
         assert mat["interactions"][m]["rolling_resistance_coefficient"] == 0.35
     m1 = load_material("M1")
     assert all(p["rolling_resistance_coefficient"] == 0 for p in m1["interactions"].values())
@@ -47,8 +47,8 @@ def test_negative_density_names_file_and_field(cfg):
 
 
 def test_unknown_key_is_an_error(cfg):
-    edit(cfg / "materials" / "M2.yaml", "  restitution: 0.3", "  restitution: 0.3\n  restitutoin: 0.3")
-    with pytest.raises(ConfigError, match=r"M2.yaml: contact.restitutoin: unknown key"):
+    edit(cfg / "materials" / "M2.yaml", "  poisson_ratio: 0.3", "  poisson_ratio: 0.3\n  restitution: 0.3")
+    with pytest.raises(ConfigError, match=r"M2.yaml: contact.restitution: unknown key"):
         load_material("M2", cfg)
 
 

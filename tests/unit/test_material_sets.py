@@ -78,9 +78,14 @@ def test_rig_for_one_material_rejects_a_set():
 
 
 def test_bad_overrides_name_file_and_field():
-    with pytest.raises(ConfigError, match=r"mixed-dry.yaml \(with overrides\): cross_interactions.M1.M2."
-                                          r"rolling_resistance_coefficient: 0.35 cannot be realised"):
-        resolve_job("aor_mixed", "mixed-dry", {"cross_interactions.M1.M2.rolling_resistance_coefficient": 0.35})
+    # a pair value the scene's contact law cannot realise names the pair's files and key and why
+    with pytest.raises(ConfigError, match=r"configs/material_sets/mixed-dry.yaml or configs/materials/M1.yaml: "
+                                          r"interactions.M2.rolling_resistance_coefficient: 0.35: linear_cundall "
+                                          r"takes rolling resistance 0 with clumps"):
+        resolve_job("aor_mixed", "mixed-dry", {"cross_interactions.M1.M2.rolling_resistance_coefficient": 0.35,
+                                               "rig.numerics.contact_model": "linear_cundall"})
+    # the default law realises a rolling resistance with clumps (the member's own radius)
+    resolve_job("aor_mixed", "mixed-dry", {"cross_interactions.M1.M2.rolling_resistance_coefficient": 0.35})
     with pytest.raises(ConfigError, match=r"components.M1.mass_percent: 5.0 differs from the sum of its size classes"):
         resolve_job("aor_mixed", "mixed-dry", {"components.M1.mass_percent": 5.0})
     with pytest.raises(ConfigError, match=r"M2.yaml \(with overrides\): particles.density_kg_m3: -1 must be > 0"):

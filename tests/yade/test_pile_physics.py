@@ -43,11 +43,12 @@ def base(tmp_path_factory):
 
 
 def test_frictionless_spheres_do_not_stand(tmp_path_factory):
-    # friction 0 on the table too would never come to rest (a sphere sliding on a
-    # frictionless plate feels no net force, so Cundall damping never stops it: the
-    # rig fails "no rest after 8 s"); the table keeps a token 0.05 so they can stop
+    # friction and rolling resistance 0 on the table too would never come to rest (a sphere
+    # sliding or rolling on it feels no net force or torque: the rig fails "no rest after
+    # 8 s"); the table keeps a token 0.05 of both so that they stop within the table
     over = dict(**partners("friction_coefficient", 0.0), **partners("rolling_resistance_coefficient", 0.0))
     over["interactions.steel.friction_coefficient"] = 0.05
+    over["interactions.steel.rolling_resistance_coefficient"] = 0.05
     res = run(tmp_path_factory, "frictionless", over)
     print("frictionless aor_mean_deg", res["aor_mean_deg"], "steps", res["steps"])
     assert res["aor_mean_deg"] < FRICTIONLESS_MAX_DEG, res["aor_mean_deg"]

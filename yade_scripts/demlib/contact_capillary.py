@@ -1,10 +1,10 @@
 """Liquid bridges: the viscoelastic-capillary contact family (runs inside YADE).
 
-Cohesion model `liquid_bridge` (pycal.configs.COHESION_MODELS), for the pair of a
+Cohesion model `liquid_bridge` (pycal.contact_rules.COHESION_MODELS), for the pair of a
 particle material with itself (fines-fines): ViscElCapMat +
 Ip2_ViscElCapMat_ViscElCapMat_ViscElCapPhys + Law2_ScGeom_ViscElCapPhys_Basic with
 Willett's bridge force (CapillarType Willett_numeric), built from the job with the
-interface of contact.ContactModel. A bridge forms when two particles touch and acts
+interface of contact_base.PairTable (law `viscoelastic_capillary`). A bridge forms when two particles touch and acts
 until their gap exceeds the rupture distance s_c = (1 + theta/2) V_b^(1/3) (Lian):
 this is the law's adhesive distance beyond contact.
 
@@ -25,12 +25,12 @@ Parameters (SI):
 
 The family replaces the whole scene's law (a pair of materials must agree on the
 capillary settings, so walls carry the same values with Capillar off). What is lost
-against contact.ContactModel:
+against the other laws:
 - rolling and twisting resistance (every rolling_resistance_coefficient must be 0:
   ViscElMat's mR torque acts only while a particle spins and lets piles creep);
 - cohesion/adhesion on any other pair (walls, other materials: model none only);
-- Cundall damping: restitution comes from the law's own dashpot (en = et = restitution),
-  NewtonIntegrator damping is 0 here (free fall at g, unlike the CohFrict family).
+- restitution per pair: the law's own dashpot (en = et) takes one value per scene;
+  NewtonIntegrator damping is 0 here (free fall at g).
 Kept: per-pair Coulomb friction (MatchMaker), real Young's modulus and Poisson ratio
 of particles and walls.
 
@@ -47,7 +47,10 @@ from yade.wrapper import (ViscElCapMat, MatchMaker, Ip2_ViscElCapMat_ViscElCapMa
                           Law2_ScGeom_ViscElCapPhys_Basic, Bo1_Sphere_Aabb, Bo1_Facet_Aabb,
                           Ig2_Sphere_Sphere_ScGeom, Ig2_Facet_Sphere_ScGeom)
 
-from .contact import ContactModel, shear_ratio
+from pycal.contact_rules import CAPILLARY_LAW
+
+from .contact_base import PairTable
+from .contact_linear import shear_ratio
 from .jobio import RigFailure
 
 WATER_DENSITY_KG_M3 = 1000.0
@@ -55,29 +58,21 @@ MODEL = "liquid_bridge"
 DETECTION_MARGIN_RATIO = 1.05     # interaction range = 1.05 x the rupture distance
 
 
-class CapillaryContactModel(ContactModel):
-    """ContactModel interface on the ViscElCap family (see the module doc)."""
+class CapillaryContactModel(PairTable):
+    """PairTable interface on the ViscElCap family (see the module doc)."""
+
+    law_name = CAPILLARY_LAW
+
+    def __init__(self, job, gravity=9.81):
+        super().__init__(job, gravity)
+        self._build()
 
     def _build(self):
+        """Materials; pycal.contact_rules has checked the pairs (rolling 0, one bridge material,
+        one restitution, no other cohesion)."""
         names = list(self.particles)
-        self.bridge = None
-        for a in names:
-            for b in names + list(self.boundaries):
-                coh = self.pair(a, b)["cohesion"]
-                if coh["model"] not in ("none", MODEL):
-                    raise RigFailure(f"materials.{a}.interactions.{b}.cohesion.model: {coh['model']!r} cannot be "
-                                     f"combined with {MODEL!r} in one scene (the liquid-bridge contact family has "
-                                     "no other cohesion); set it to none")
-                if coh["model"] == MODEL and a != b:
-                    raise RigFailure(f"materials.{a}.interactions.{b}.cohesion: {MODEL} acts between particles "
-                                     "of one material only (fines-fines)")
-                if coh["model"] == MODEL:
-                    if self.bridge is not None:
-                        raise RigFailure(f"{MODEL}: one material with liquid bridges per scene")
-                    self.bridge = (a, coh)
-                if self.pair(a, b)["rolling_resistance_coefficient"] != 0:
-                    raise RigFailure(f"materials.{a}.interactions.{b}.rolling_resistance_coefficient: the "
-                                     f"{MODEL} contact family has no rolling resistance; set it to 0")
+        self.bridge = next(((a, self.pair(a, a)["cohesion"]) for a in names
+                            if self.pair(a, a)["cohesion"]["model"] == MODEL), None)
         if self.bridge is None:
             raise RigFailure(f"{MODEL}: no pair uses it")
         name, coh = self.bridge
@@ -96,10 +91,7 @@ class CapillaryContactModel(ContactModel):
         self.bridge_force_max = 2.0 * math.pi * r * coh["surface_tension_n_m"] * math.cos(theta)
         cap = dict(CapillarType="Willett_numeric", Vb=self.bridge_volume, gamma=coh["surface_tension_n_m"],
                    theta=coh["contact_angle_deg"], dcap=0.0)
-        es = {self.particles[n]["contact"]["restitution"] for n in names}
-        if len(es) > 1:
-            raise RigFailure(f"one restitution per scene is supported: {sorted(es)}")
-        e = es.pop()
+        e = self.pair(name, name)["restitution_coefficient"]
         for n in names:
             q = self.particles[n]
             c = q["contact"]
@@ -114,24 +106,13 @@ class CapillaryContactModel(ContactModel):
                              label=bname, **cap)
             self.mat_id[bname] = O.materials.append(m)
 
-    def _check_rolling(self):
-        pass
-
     def cohesion_force(self, a, b):
         """Largest bridge force (N) of the pair (Willett at contact: 2 pi R gamma cos theta)."""
         return self.bridge_force_max if self.pair(a, b)["cohesion"]["model"] == MODEL else 0.0
 
-    def ip2(self):
-        fric = []
-        names = list(self.particles)
-        for i, a in enumerate(names):
-            for b in names[i:] + list(self.boundaries):
-                fric.append((self.mat_id[a], self.mat_id[b], math.atan(self.pair(a, b)["friction_coefficient"])))
-        bnames = list(self.boundaries)
-        for i, a in enumerate(bnames):
-            for b in bnames[i:]:
-                fric.append((self.mat_id[a], self.mat_id[b], 0.0))
-        return Ip2_ViscElCapMat_ViscElCapMat_ViscElCapPhys(frictAngle=MatchMaker(matches=fric, algo="avg"))
+    def ip2_functors(self):
+        return [Ip2_ViscElCapMat_ViscElCapMat_ViscElCapPhys(frictAngle=MatchMaker(matches=self.friction_matches(),
+                                                                                  algo="avg"))]
 
     def law2(self):
         return Law2_ScGeom_ViscElCapPhys_Basic()

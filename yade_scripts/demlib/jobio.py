@@ -19,6 +19,7 @@ _T0 = time.time()
 _STARTED = datetime.datetime.now(datetime.timezone.utc).isoformat(timespec="seconds")
 
 
+from pycal.contact_rules import law_of_job
 from pycal.rig_contract import RESULT_FILE, RIG_FAILURE_FILE, EXIT_RIG_FAILURE, EXIT_ERROR, EXIT_OK
 
 
@@ -75,9 +76,9 @@ def provenance():
         yade_version = "unknown"
     try:
         from yade import O
-        threads = O.numThreads
+        threads, simulated_time, steps = O.numThreads, O.time, O.iter
     except Exception:
-        threads = None
+        threads = simulated_time = steps = None
     commit = _git("rev-parse", "HEAD") or "unknown"
     dirty = bool(_git("status", "--porcelain", "--untracked-files=no"))
     return {
@@ -90,6 +91,8 @@ def provenance():
         "started_utc": _STARTED,
         "finished_utc": datetime.datetime.now(datetime.timezone.utc).isoformat(timespec="seconds"),
         "wall_time_s": round(time.time() - _T0, 3),
+        "simulated_time_s": simulated_time,
+        "steps_count": steps,
     }
 
 
@@ -114,10 +117,10 @@ def write_csv(out_dir, name, columns, rows):
 
 
 def write_result(out_dir, job, measurements):
-    """result.json = measurements + job + provenance. Call once, last."""
+    """result.json = measurements + the contact law that made them + job + provenance. Call once, last."""
     result = dict(measurements)
     result.update({"job_id": job.get("job_id"), "rig": job["rig"], "material": job["material"],
-                   "seed": job["seed"], "job": job, "provenance": provenance()})
+                   "seed": job["seed"], "contact_model": law_of_job(job), "job": job, "provenance": provenance()})
     text = json.dumps(result, indent=1, sort_keys=True, allow_nan=False)
     _atomic_write(os.path.join(out_dir, RESULT_FILE), text)
     print("RESULT written:", os.path.join(out_dir, RESULT_FILE), flush=True)

@@ -264,7 +264,9 @@ def _scene_class():
             bodies = self.dynamic_bodies()
             if not bodies:
                 return 0.0
-            ke = sum(clumps.clump_kinetic_energy(b) for b in bodies)
+            rotation = self.num["rest_kinetic_energy"] == "total"
+            ke = sum(clumps.clump_kinetic_energy(b) if rotation else 0.5 * b.state.mass * b.state.vel.squaredNorm()
+                     for b in bodies)
             ref = sum(b.state.mass for b in bodies) * self.g * 2.0 * self.radius
             return ke / ref
 

@@ -7,9 +7,7 @@ import math
 import random
 
 from yade import O, utils, geom, pack
-from yade.wrapper import (ForceResetter, InsertionSortCollider, Bo1_Sphere_Aabb, Bo1_Facet_Aabb,
-                          InteractionLoop, Ig2_Sphere_Sphere_ScGeom6D, Ig2_Facet_Sphere_ScGeom6D,
-                          NewtonIntegrator, Sphere)
+from yade.wrapper import ForceResetter, InsertionSortCollider, InteractionLoop, NewtonIntegrator
 from yade import Vector3
 
 from .contact_models import make_contact_model
@@ -30,14 +28,14 @@ class Scene:
         self.material = job["material"]
         O.reset()
         random.seed(job["seed"])
-        self.contact = make_contact_model(job, gravity=self.g)   # family chosen by the cohesion models
+        self.contact = make_contact_model(job, gravity=self.g)   # the law of pycal.contact_rules.law_of_job
         self.radius = self.length_scale()
         self.newton = NewtonIntegrator(gravity=(0, 0, -self.g), damping=self.contact.damping(),
-                                       dampGravity=True, label="newton")
+                                       dampGravity=self.contact.damp_gravity, label="newton")
         O.engines = [
             ForceResetter(),
             InsertionSortCollider(self.contact.bounding_functors()),
-            InteractionLoop(self.contact.geometry_functors(), [self.contact.ip2()], [self.contact.law2()]),
+            InteractionLoop(self.contact.geometry_functors(), self.contact.ip2_functors(), [self.contact.law2()]),
         ] + self.contact.extra_engines() + [self.newton]
         self.sphere_ids = []
         self.box_min = Vector3(-1, -1, -1)   # rig's bounding box for the escape guard (set by geometry)
@@ -111,11 +109,11 @@ class Scene:
     def kinetic_energy_ratio(self):
         """Kinetic energy of the particles / (their weight x one diameter) (-); of
         translation only if the rig's numerics say rest_kinetic_energy: translational
-        (pycal.configs.OPTIONAL_NUMERICS; without the key: translation and rotation)."""
+        (pycal.configs.NUMERICS_CHOICES)."""
         spheres = self.live_spheres()
         if not spheres:
             return 0.0
-        rotation = self.num.get("rest_kinetic_energy", "total") == "total"
+        rotation = self.num["rest_kinetic_energy"] == "total"
         ke = sum(0.5 * b.state.mass * b.state.vel.squaredNorm()
                  + (0.5 * sum(b.state.inertia[k] * b.state.angVel[k] ** 2 for k in range(3)) if rotation else 0.0)
                  for b in spheres)
@@ -130,8 +128,11 @@ class Scene:
         if mean_contact == 0.0:
             return 0.0
         grav = self.newton.gravity
+        # with global damping a of the contact forces only (gravity undamped), a body at rest
+        # is held by (1 - a) x its contact force: that is the force to balance against gravity
+        held = 1.0 - self.newton.damping if not self.newton.dampGravity else 1.0
         bodies = self.dynamic_bodies()
-        resid = sum((self.body_force(b) + grav * b.state.mass).norm() for b in bodies) / len(bodies)
+        resid = sum((held * self.body_force(b) + grav * b.state.mass).norm() for b in bodies) / len(bodies)
         return resid / mean_contact
 
     def dynamic_bodies(self):

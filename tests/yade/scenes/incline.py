@@ -17,7 +17,8 @@ def main():
     sc = Scene(job)
     sc.add_table(0.5, "steel")
     r = sc.radius
-    b = O.bodies.append(utils.sphere((0, 0, r), r, material=sc.contact.mat_id[job["material"]]))
+    # inside one facet (on the shared diagonal a sphere would touch both facets)
+    b = O.bodies.append(utils.sphere((0.03, 0.01, r), r, material=sc.contact.mat_id[job["material"]]))
     O.bodies[b].state.blockedDOFs = "XYZ"
     sc.set_timestep()
     g = sc.g
@@ -32,6 +33,7 @@ def main():
         O.run(chunk, True)
     sc.newton.gravity = Vector3(g * math.sin(t_end), 0, -g * math.cos(t_end))
     x1 = O.bodies[b].state.pos[0]
+    v1 = O.bodies[b].state.vel.norm()
     O.run(int(p["hold_s"] / O.dt), True)
     st = O.bodies[b].state
     fn = ft = 0.0
@@ -42,6 +44,7 @@ def main():
     _common.finish(out, {"tan_angle": p["tan_angle"], "angle_deg": math.degrees(t_end),
                          "slide_during_ramp_m": x1 - x0, "slide_total_m": st.pos[0] - x0,
                          "slide_during_hold_m": st.pos[0] - x1, "damping": sc.newton.damping, "final_speed_m_s": st.vel.norm(),
+                         "speed_at_hold_m_s": v1,
                          "ft_over_fn": ft / fn if fn else None, "timestep_s": O.dt})
 
 

@@ -1,6 +1,6 @@
-"""Hysteretic cohesion on the CohFrict contact law (runs inside YADE).
+"""Hysteretic cohesion on the linear_cundall contact law (runs inside YADE).
 
-Cohesion model `hysteretic` (pycal.configs.COHESION_MODELS): the pull-off force of a
+Cohesion model `hysteretic` (pycal.contact_rules.COHESION_MODELS): the pull-off force of a
 contact grows with the largest compressive force it has carried, as in Luding's
 elasto-plastic adhesive law (pull-off proportional to the largest overlap), but on the
 same contact law as every other model (CohFrictMat + Law2_ScGeom6D_CohFrictPhys_
@@ -37,14 +37,14 @@ import __main__
 from yade import O
 from yade.wrapper import PyRunner
 
-from .contact import ContactModel
+from .contact_linear import LinearCundallContactModel
 from .jobio import RigFailure
 
 HOOK = "_pycal_hysteretic_update"
 
 
-class HystereticContactModel(ContactModel):
-    """ContactModel + the `hysteretic` cohesion model (see the module doc)."""
+class HystereticContactModel(LinearCundallContactModel):
+    """LinearCundallContactModel + the `hysteretic` cohesion model (see the module doc)."""
 
     MODEL = "hysteretic"
 
