@@ -626,15 +626,11 @@ def run_friction_rig(job, build, out_dir):
     })
     if getattr(scene.contact, "n_updates", None) is not None:
         out["cohesion_update_count"] = cohesion_updates + scene.contact.n_updates
-    # friction vs stress against the lab curve (CSV, PNG, misfit): pycal.post.friction
-    try:
-        from pycal.post import friction as post
-        res = dict(out, rig=scene.job["rig"], material=scene.job["material"], seed=scene.job["seed"],
-                   job=scene.job)
-        done = post.write_outputs([res], out_dir)
-        out["misfits"] = done["misfits"]
-        out["output_files"] = [os.path.basename(f) for f in done["files"]]
-    except Exception as exc:      # plots must not cost the simulation
-        print(f"WARNING: friction outputs not complete: {type(exc).__name__}: {exc}", flush=True)
-        out["misfits"] = {}
+    # friction vs stress against the lab curve (CSV, PNG, misfit): pycal.post.friction; an
+    # error here is a bug: the run fails (exit 4, not kept as a verdict), nothing is hidden
+    from pycal.post import friction as post
+    res = dict(out, rig=scene.job["rig"], material=scene.job["material"], seed=scene.job["seed"], job=scene.job)
+    done = post.write_outputs([res], out_dir)
+    out["misfits"] = done["misfits"]
+    out["output_files"] = [os.path.basename(f) for f in done["files"]]
     return out
