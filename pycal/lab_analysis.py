@@ -5,7 +5,6 @@ CLI: `pycal impact ...` (one design case) and `pycal analyse --out DIR` (table o
 derived quantities, impact stress vs drop height as CSV and PNG).
 """
 import math
-import os
 from pathlib import Path
 
 import numpy as np
@@ -13,6 +12,7 @@ import pandas as pd
 
 from . import labdata
 from .errors import ConfigError
+from .files import atomic_path
 
 G_M_S2 = 9.81
 
@@ -211,24 +211,11 @@ def cli_impact(args):
     return r
 
 
-def _replace_atomically(path, write):
-    """Call write(tmp_path), then rename tmp_path to path (no half-written file)."""
-    path = Path(path)
-    tmp = path.with_name(f".{path.name}.{os.getpid()}.tmp")
-    try:
-        write(tmp)
-        os.replace(tmp, path)
-    finally:
-        if tmp.exists():
-            tmp.unlink()
-
-
 def plot_impact(curve, design_h_m, design_p_pa, highest_step_pa, path, label="impact stress"):
     """PNG of impact stress (kPa) vs drop height (m), marking the design drop height
     (m) and its stress (Pa) and, if given, the highest lab load step (Pa)."""
-    from matplotlib.figure import Figure   # no pyplot: Agg canvas, no global state
-    fig = Figure(figsize=(6.4, 4.4))
-    ax = fig.add_subplot()
+    from .plotting import new_figure, save_png
+    fig, ax = new_figure(figsize=(6.4, 4.4))
     ax.plot(curve["drop_height_m"], curve["impact_stress_pa"] / 1000, "-", color="C0", label=label)
     ax.axvline(design_h_m, color="C3", ls="--", lw=1)
     ax.plot([design_h_m], [design_p_pa / 1000], "o", color="C3",
@@ -242,7 +229,7 @@ def plot_impact(curve, design_h_m, design_p_pa, highest_step_pa, path, label="im
     ax.grid(alpha=0.3)
     ax.legend(loc="upper left")
     fig.tight_layout()
-    _replace_atomically(path, lambda tmp: fig.savefig(tmp, format="png", dpi=120))
+    save_png(fig, path, dpi=120)
 
 
 def cli_analyse(args):
@@ -252,16 +239,16 @@ def cli_analyse(args):
     out = Path(args.out)
     out.mkdir(parents=True, exist_ok=True)
     table = derived_quantities(lab)
-    _replace_atomically(out / "derived_quantities.csv",
-                        lambda tmp: table.to_csv(tmp, index=False, float_format="%.6g"))
+    with atomic_path(out / "derived_quantities.csv") as tmp:
+        table.to_csv(tmp, index=False, float_format="%.6g")
 
     s = lab["samples"]
     belt, rho0, h = s["belt"], s["material"]["mine_bulk_density_kg_m3"], s["design"]["drop_height_m"]
     heights = np.round(np.arange(0.5, 15.0 + 1e-9, 0.5), 6)
     curve = impact_vs_drop_height(heights, belt["speed_m_s"], t_h_to_kg_s(belt["flow_t_h"]), rho0)
     curve = curve.drop(columns="stream_area_m2")
-    _replace_atomically(out / "impact_vs_drop_height.csv",
-                        lambda tmp: curve.to_csv(tmp, index=False, float_format="%.6g"))
+    with atomic_path(out / "impact_vs_drop_height.csv") as tmp:
+        curve.to_csv(tmp, index=False, float_format="%.6g")
     design = impact_stress(h, belt["speed_m_s"], t_h_to_kg_s(belt["flow_t_h"]), rho0)
     highest = max((c["stress_pa"].max() for c in lab["curves"].values()), default=None)
     label = (f"impact stress ({belt['flow_t_h']:g} t/h, {belt['speed_m_s']:g} m/s, "
