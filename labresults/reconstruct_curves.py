@@ -1,4 +1,4 @@
-"""Write the reconstructed target curves of lab-tests.md section 8 to curves/*.csv.
+"""Write the reconstructed target curves of docs/lab-tests.md section 8 to curves/*.csv.
 
 The case study shows these curves only as plots without numbers; each rule below
 turns what its text says into a target and a band (README.md has the table).
@@ -125,7 +125,7 @@ def write_curve(path, rule, columns, outcome):
     for q in columns:
         header += [q, f"{q}_low", f"{q}_high"]
     header += (["outcome"] if outcome else []) + ["provenance"]
-    lines = [f"# reconstructed from the text of lab-tests.md section 8: {rule}", ",".join(header)]
+    lines = [f"# reconstructed from the text of docs/lab-tests.md section 8: {rule}", ",".join(header)]
     for s in STEPS_PA:
         row = [str(s)]
         out = outcome(s) if outcome else "slides"

@@ -1,4 +1,4 @@
-"""Rig 2: cylinder-lift angle of repose (method.md rig 2, lab-tests.md section 4).
+"""Rig 2: cylinder-lift angle of repose (docs/rigs.md, docs/lab-tests.md section 4).
 
 Fill the 145 x 95 mm PVC cylinder standing on the steel table (rigs.fill_cell: pour,
 settle, strike level), lift the cylinder kinematically at lift_speed_m_s until its

@@ -1,5 +1,5 @@
 """Rig 2 for a material set: cylinder-lift angle of repose of a mixed sample (M1 clumps
-+ M2 + M3 spheres, lab-tests.md section 4: the -50 mm sample).
++ M2 + M3 spheres, docs/lab-tests.md section 4: the -50 mm sample).
 
 Fill the 145 x 95 mm PVC cylinder on the steel table with the set's particles by mass
 (demlib.mixed: generated mass split by the components' mass fractions and the M1

@@ -1,4 +1,4 @@
-"""Rig 6: internal friction (method.md rig 6, lab-tests.md sections 8-9).
+"""Rig 6: internal friction (docs/rigs.md, docs/lab-tests.md sections 8-9).
 
 A fixed PVC cell stands on the steel table; a mobile cell (a rigid clump of
 cell_mass_kg) is stacked on it with a gap of cell_gap_m, so the shear plane runs

@@ -1,4 +1,4 @@
-"""Rig 3: surcharge angle after vibration (method.md rig 3, lab-tests.md section 5).
+"""Rig 3: surcharge angle after vibration (docs/rigs.md, docs/lab-tests.md section 5).
 
 Same as the AoR rig up to the settled pile and its angles (aor_* keys, pile_*.csv),
 then the table facets move kinematically on an ellipse (x = A_h sin wt,

@@ -1,5 +1,5 @@
 """Rig 4c: unconfined compression (UCS) - a pile formed as in the AoR test, pressed by
-the steel plate, material free to move sideways (method.md rig 4).
+the steel plate, material free to move sideways (docs/rigs.md).
 
 Fill the cylinder on the table, lift it at lift_speed_m_s until clear and settle the
 pile as the AoR rig does (rigs.cylinder_lift_pile), then a

@@ -1,4 +1,4 @@
-"""Rig 5: tilt-table wall friction (method.md rig 5, lab-tests.md sections 8-9).
+"""Rig 5: tilt-table wall friction (docs/rigs.md, docs/lab-tests.md sections 8-9).
 
 The filled cell (a rigid clump of PVC facets standing cell_gap_to_plate_m above the
 steel bearing plate, so only the material touches the plate) carries a steel lid.

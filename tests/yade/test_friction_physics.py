@@ -34,7 +34,6 @@ Bounds, from measurements of these scenes (tilt 2 deg/s, onset 1 mm, travel 10 m
 """
 import json
 import os
-import shutil
 import subprocess
 import textwrap
 from pathlib import Path
@@ -45,8 +44,7 @@ from pycal import REPO_ROOT
 from pycal.jobs import resolve_job
 from pycal.runner import run_job, yade_env
 
-pytestmark = [pytest.mark.yade,
-              pytest.mark.skipif(shutil.which("yade") is None, reason="yade is not installed")]
+pytestmark = pytest.mark.yade
 
 SEED = 1
 NO_ROLL = {"interactions.M2.rolling_resistance_coefficient": 1.0,

@@ -3,15 +3,13 @@
 Each job goes through pycal.jobs.resolve_job + pycal.runner.run_job into a pytest tmp
 folder and the assertions read its result.json.
 """
-import shutil
 
 import pytest
 
 from pycal.jobs import resolve_job
 from pycal.runner import run_job
 
-pytestmark = [pytest.mark.yade,
-              pytest.mark.skipif(shutil.which("yade") is None, reason="yade is not installed")]
+pytestmark = pytest.mark.yade
 
 MATERIAL = "M2"
 SEED = 3
