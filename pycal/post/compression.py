@@ -269,6 +269,7 @@ def write_outputs(result, out_dir=None, lab_dir=None, plots=True):
     sample = lab_sample_of(result)
     targets = load_targets(result["rig"], sample, lab_dir) if sample else {}
     comps = compare(result, targets)
+    os.makedirs(out_dir, exist_ok=True)
     files = [write_curve_csv(result, os.path.join(out_dir, "spring_curve.csv"))]
     if comps:
         files.append(write_comparison_csv(comps, os.path.join(out_dir, "lab_comparison.csv")))

@@ -28,6 +28,8 @@ from pycal.jobs import resolve_job
 from pycal.runner import run_job, yade_env
 from yade_scripts.demlib import clumps  # pure-Python parts: numpy only
 
+from documented import assert_documented
+
 pytestmark = pytest.mark.yade
 
 SHAPES = resolve_job("aor_mixed", "mixed-dry")["materials"]["M1"]["particles"]["shapes"]
@@ -201,6 +203,7 @@ def test_aor_mixed_rig_runs_and_reports(tmp_path):
     assert res["fill_mass_kg"] <= res["generated_mass_kg"]
     # YADE's time step is the one pycal estimated before the run (smallest lump member)
     assert res["timestep_s"] == pytest.approx(critical_timestep(job)[0], rel=1e-6)
+    assert_documented(res)
     out = tmp_path / "aor_mixed" / job["job_id"]
     for f in ("pile_particles.csv", "pile_profile.csv", "pile_upper_profile.csv", "pile_side.png"):
         assert (out / f).is_file(), f

@@ -35,6 +35,8 @@ from pycal.errors import RunError
 from pycal.jobs import resolve_job
 from pycal.runner import run_job, job_dir
 
+from documented import assert_documented
+
 pytestmark = pytest.mark.yade
 
 MATERIAL = "M2"
@@ -98,6 +100,7 @@ def test_ccs_result_has_the_per_step_arrays_and_files(ccs):
     header = (folder / "spring_curve.csv").read_text().splitlines()[0]
     assert "stress_pa" in header and "strain_ratio" in header and "stiffness_pa" in header
     assert "bulk_stiffness" in ccs["misfits"]
+    assert_documented(ccs)
 
 
 def test_force_balance_at_every_step(soft, stiff, ccs):
@@ -118,6 +121,7 @@ def test_bulk_stiffness_grows_with_youngs_modulus(soft, stiff):
 
 
 def test_unloading_is_stiffer_than_loading(soft, stiff):
+    assert_documented(soft)
     for r in (soft, stiff):
         assert r["branch"] == ["loading", "loading", "unloading"]
         assert r["unloading_stiffness_pa"][0] > loading_last(r), r["job_id"]
@@ -160,6 +164,7 @@ def test_ucs_pile_under_the_plate(tmp_path_factory):
     assert 0 < r["strain"][0] < r["strain"][1] < 0.5
     assert r["initial_height_m"] < 0.095 + 0.0125           # a pile, lower than the filled cell's top
     assert r["load_stopped_at_pa"] is None and r["load_steps_completed_count"] == 2
+    assert_documented(r)
 
 
 def test_ucs_loading_stops_at_the_overlap_limit_with_the_steps_reached(tmp_path_factory):

@@ -16,6 +16,8 @@ from pycal.errors import RunError
 from pycal.jobs import resolve_job
 from pycal.runner import run_job, job_dir, yade_env
 
+from documented import assert_documented
+
 pytestmark = pytest.mark.yade
 
 SCENES = Path(__file__).resolve().parent / "scenes"
@@ -58,6 +60,7 @@ def test_fill_mass_is_count_times_particle_mass(fill_pair):
     geo = job["rig_config"]["geometry"]
     vol = math.pi * geo["cell_inner_diameter_m"] ** 2 / 4 * geo["cell_height_m"]
     assert res["bulk_density_kg_m3"] == pytest.approx(res["mass_kg"] / vol, rel=1e-9)
+    assert_documented(res)
 
 
 def test_time_step_is_the_one_estimated_before_the_run(fill_pair):

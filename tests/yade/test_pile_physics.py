@@ -9,6 +9,8 @@ import pytest
 from pycal.jobs import resolve_job
 from pycal.runner import run_job
 
+from documented import assert_documented
+
 pytestmark = pytest.mark.yade
 
 MATERIAL = "M2"
@@ -66,3 +68,4 @@ def test_same_seed_is_bit_identical(tmp_path_factory, base):
     assert again["provenance"]["started_utc"] and again["job_id"] == base["job_id"]
     for k in ANGLES + ("steps", "n_particles", "pile_height_m"):
         assert again[k] == base[k], k
+    assert_documented(base)
