@@ -4,8 +4,9 @@ steps = longest simulated time of the rig (s) / time step (s).
 
 - Time step (s): what the rigs use, numerics.timestep_safety_factor x YADE's
   PWaveTimeStep, i.e. the smallest radius / sqrt(E / density) over the particle
-  spheres (clump members included; their radius follows the lump rule of
-  yade_scripts/demlib/clumps.py).
+  spheres. For clump materials the smallest member a lump of the job's size classes
+  can have (lump rule of yade_scripts/demlib/clumps.py at the class's minimum size):
+  the run's own time step, set by the lumps actually drawn, is that or longer.
 - Longest simulated time (s): the sum of the rig's phases, each at its limit: a rest
   wait (settle, load step) ends after at most numerics.max_settle_time_s (plus one rest
   check interval) or the rig fails; a cylinder lift ends by its own time limit

@@ -1,5 +1,4 @@
 """Lab analysis formulas and the `impact` / `analyse` commands."""
-import math
 
 import pandas as pd
 import pytest

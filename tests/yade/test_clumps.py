@@ -201,8 +201,10 @@ def test_aor_mixed_rig_runs_and_reports(tmp_path):
     # the strike removes spheres only: the lumps' share can only grow, the mass only shrink
     assert res["mass_fraction_M1_final"] >= res["mass_fraction_M1_generated"]
     assert res["fill_mass_kg"] <= res["generated_mass_kg"]
-    # YADE's time step is the one pycal estimated before the run (smallest lump member)
-    assert res["timestep_s"] == pytest.approx(critical_timestep(job)[0], rel=1e-6)
+    # YADE's time step comes from the smallest member sphere of the lumps drawn; pycal's
+    # estimate before the run assumes the smallest possible one (a 25 mm oblong: 5.15 mm),
+    # so it is never longer than YADE's, and a lump member is smaller than a 25 mm sphere
+    assert critical_timestep(job)[0] <= res["timestep_s"] < 8.028e-5
     assert_documented(res)
     out = tmp_path / "aor_mixed" / job["job_id"]
     for f in ("pile_particles.csv", "pile_profile.csv", "pile_upper_profile.csv", "pile_side.png"):
