@@ -7,6 +7,8 @@ import subprocess
 from pycal import REPO_ROOT
 
 DOCS = REPO_ROOT / "docs"
+# the outside pages the code used to cite (pieced together so that this file does not match itself)
+OUTSIDE = "shared" + r"/spec|/work" + r"/|method\.md|lab-tests\.md|yade-notes\.md"
 # files being rewritten in issue 18 that still cite the old outside pages: remove an
 # entry when its file is done (the test then holds for it too)
 NOT_YET = {"pycal/calibration/calibrate_cli.py", "pycal/calibration/density.py", "yade_scripts/demlib/contact.py"}
@@ -17,19 +19,19 @@ def _squash(text):
 
 
 def test_nothing_points_outside_the_repo():
-    out = subprocess.run(["git", "grep", "-nE", r"shared/spec|/work/|method\.md|lab-tests\.md|yade-notes\.md"],
+    out = subprocess.run(["git", "grep", "-nE", OUTSIDE],
                          cwd=REPO_ROOT, capture_output=True, text=True).stdout
     bad = []
     for line in out.splitlines():
         path, _, text = line.split(":", 2)
-        if path in NOT_YET or path == "tests/unit/test_docs.py":
+        if path in NOT_YET:
             continue
         # a link to a docs/ page is fine; anything else names a file the repo does not have
         rest = re.sub(r"docs/(method|lab-tests|rigs|troubleshooting|glossary|contact-models)\.md", "", text)
         if path.startswith("docs/"):
             rest = re.sub(r"\((method|lab-tests|rigs|troubleshooting|glossary)\.md\)|\b(contact-models|method|"
                           r"lab-tests)\.md", "", rest)
-        if re.search(r"shared/spec|/work/|method\.md|lab-tests\.md|yade-notes\.md", rest):
+        if re.search(OUTSIDE, rest):
             bad.append(line)
     assert not bad, "references outside the repo:\n" + "\n".join(bad)
 
