@@ -13,7 +13,6 @@ import json
 import platform
 import shutil
 import statistics
-import subprocess
 import sys
 import tempfile
 import time
@@ -22,6 +21,7 @@ from pathlib import Path
 ROOT = Path(__file__).resolve().parent.parent
 sys.path.insert(0, str(ROOT))
 
+from pycal.gitinfo import git_commit  # noqa: E402
 from pycal.jobs import resolve_job  # noqa: E402
 from pycal.runner import run_job  # noqa: E402
 
@@ -41,11 +41,8 @@ RESULTS = Path(__file__).resolve().parent / "results.jsonl"
 
 
 def _git_commit():
-    try:
-        return subprocess.run(["git", "-C", str(ROOT), "rev-parse", "--short", "HEAD"], capture_output=True,
-                              text=True, timeout=10).stdout.strip()
-    except Exception:
-        return "unknown"
+    """Short commit hash (bench/twin.py imports this name)."""
+    return git_commit(short=True)
 
 
 def run_bench(name, runs=3):

@@ -1,4 +1,4 @@
-"""Write the reconstructed target curves of lab-tests.md section 8 to curves/*.csv.
+"""Write the reconstructed target curves of docs/lab-tests.md section 8 to curves/*.csv.
 
 The case study shows these curves only as plots without numbers; each rule below
 turns what its text says into a target and a band (README.md has the table).
@@ -9,7 +9,7 @@ dropped in (or remove their names from CURVES first).
 import math
 from pathlib import Path
 
-STEPS_PA = [3000, 6000, 12000, 24000, 40000, 60000, 86000]   # the rigs' load steps
+STEPS_PA = [3000, 6000, 12000, 24000, 40000, 60000, 90000]   # the rigs' load steps (top: above the design impact stress, 88.6 kPa)
 PARTICLE_DENSITY = 2750.0                                     # kg/m3
 BULK_DENSITY = {"fines_dry": 1601.0, "fines_wet": 1146.0, "gravel_dry": 1603.0}  # kg/m3
 DRY_RAMP_SLOPE = 0.1 / (60000 - 3000)   # 1/Pa: dry fines wall friction, 3 kPa -> plateau
@@ -125,7 +125,7 @@ def write_curve(path, rule, columns, outcome):
     for q in columns:
         header += [q, f"{q}_low", f"{q}_high"]
     header += (["outcome"] if outcome else []) + ["provenance"]
-    lines = [f"# reconstructed from the text of lab-tests.md section 8: {rule}", ",".join(header)]
+    lines = [f"# reconstructed from the text of docs/lab-tests.md section 8: {rule}", ",".join(header)]
     for s in STEPS_PA:
         row = [str(s)]
         out = outcome(s) if outcome else "slides"

@@ -194,12 +194,19 @@ def load_boundaries_cached(config_dir=CONFIG_DIR):
     return _BOUNDARIES[key]
 
 
+def _config_file(config_dir, folder, name, kind):
+    """configs/<folder>/<name>.yaml and the names known there; an unknown name is a
+    ConfigError listing the known ones."""
+    names = sorted(p.stem for p in (Path(config_dir) / folder).glob("*.yaml"))
+    path = Path(config_dir) / folder / f"{name}.yaml"
+    if name not in names:
+        raise ConfigError(_rel(path), "", f"unknown {kind} {name!r} (known: {', '.join(names)})")
+    return path, names
+
+
 def load_material(name, config_dir=CONFIG_DIR):
     """One validated material config by name (file configs/materials/<name>.yaml)."""
-    names = material_names(config_dir)
-    path = Path(config_dir) / "materials" / f"{name}.yaml"
-    if name not in names:
-        raise ConfigError(_rel(path), "", f"unknown material {name!r} (known: {', '.join(names)})")
+    path, names = _config_file(config_dir, "materials", name, "material")
     partners = set(names) | set(load_boundaries_cached(config_dir))
     return validate_material(load_yaml(path), path, partners)
 
@@ -262,10 +269,7 @@ def rig_names(config_dir=CONFIG_DIR):
 
 def load_rig(name, config_dir=CONFIG_DIR):
     """One validated rig config by name, with the shared numerics merged in."""
-    names = rig_names(config_dir)
-    path = Path(config_dir) / "rigs" / f"{name}.yaml"
-    if name not in names:
-        raise ConfigError(_rel(path), "", f"unknown rig {name!r} (known: {', '.join(names)})")
+    path, _ = _config_file(config_dir, "rigs", name, "rig")
     data = load_yaml(path)
     c = _Checker(path)
     c.keys(data, "", ["name", "script", "geometry", "procedure"],
@@ -402,10 +406,7 @@ def load_material_set(name, config_dir=CONFIG_DIR, materials=None):
     """One validated material set by name (configs/material_sets/<name>.yaml), with
     each component's mass_fraction. `materials` (optional): the component configs to
     validate against (default: the shipped ones)."""
-    names = material_set_names(config_dir)
-    path = Path(config_dir) / SET_DIR / f"{name}.yaml"
-    if name not in names:
-        raise ConfigError(_rel(path), "", f"unknown material set {name!r} (known: {', '.join(names)})")
+    path, _ = _config_file(config_dir, SET_DIR, name, "material set")
     if materials is None:
         materials = {m: load_material(m, config_dir) for m in material_names(config_dir)}
     return validate_material_set(load_yaml(path), path, materials)

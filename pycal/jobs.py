@@ -2,7 +2,9 @@
 
 The resolved job holds every number the rig script uses (no hidden defaults).
 Its content hash names its folder, so a job with a complete result is never run
-twice and an interrupted study resumes where it stopped.
+twice and an interrupted study resumes where it stopped. A job whose estimated step
+count is above numerics.max_estimated_steps_count is refused here, before anything
+is written (pycal.step_estimate).
 """
 import copy
 import hashlib
@@ -17,6 +19,7 @@ from .configs import (parse_yaml_text, load_boundaries_cached, load_material, lo
 from .configs import SET_DIR, load_yaml, material_set_names, rig_names, validate_material_set
 from .contact_rules import ContactRuleError, check_job
 from .errors import ConfigError
+from . import step_estimate
 
 JOB_FORMAT = 1
 
@@ -72,20 +75,7 @@ def resolve_job(rig, material, overrides=None, seed=1, config_dir=CONFIG_DIR):
     rig_checker = _Checker(f"configs/rigs/{rig}.yaml (with overrides)")
     check_rig_keys(rig_cfg, rig_checker)
     check_numerics_choices(rig_cfg["numerics"], rig_checker, "numerics.")
-    job = {
-        "job_format": JOB_FORMAT,
-        "rig": rig,
-        "script": rig_cfg["script"],
-        "seed": seed,
-        "material": material,
-        "materials": {material: mat},
-        "boundaries": copy.deepcopy(load_boundaries_cached(config_dir)),
-        "rig_config": rig_cfg,
-        "overrides": overrides,
-    }
-    check_contacts(job)
-    job["job_id"] = job_id(job)
-    return job
+    return _finish_job(rig, rig_cfg, seed, material, {material: mat}, overrides, config_dir)
 
 
 def resolve_set_job(rig, set_name, overrides=None, seed=1, config_dir=CONFIG_DIR):
@@ -132,20 +122,27 @@ def resolve_set_job(rig, set_name, overrides=None, seed=1, config_dir=CONFIG_DIR
         for b, props in pairs.items():
             materials[a]["interactions"][b] = copy.deepcopy(props)
             materials[b]["interactions"][a] = copy.deepcopy(props)
+    return _finish_job(rig, rig_cfg, seed, set_name, materials, overrides, config_dir, material_set=mset)
+
+
+def _finish_job(rig, rig_cfg, seed, material, materials, overrides, config_dir, material_set=None):
+    """The job dict (one material or a material set) with its job_id."""
     job = {
         "job_format": JOB_FORMAT,
         "rig": rig,
         "script": rig_cfg["script"],
         "seed": seed,
-        "material": set_name,
+        "material": material,
         "materials": materials,
-        "material_set": mset,
         "boundaries": copy.deepcopy(load_boundaries_cached(config_dir)),
         "rig_config": rig_cfg,
         "overrides": overrides,
     }
+    if material_set is not None:
+        job["material_set"] = material_set
     check_contacts(job)
     job["job_id"] = job_id(job)
+    step_estimate.check(job)      # refuses a job that would run for an implausible number of steps
     return job
 
 

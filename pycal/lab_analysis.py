@@ -1,11 +1,10 @@
 """Lab analysis: moisture, solid fractions, belt load, rolling-resistance estimate and
-the impact stress a chute imposes (lab-tests.md sections 3, 7 and 9). SI units.
+the impact stress a chute imposes (docs/lab-tests.md sections 3, 7 and 9). SI units.
 
 CLI: `pycal impact ...` (one design case) and `pycal analyse --out DIR` (table of
 derived quantities, impact stress vs drop height as CSV and PNG).
 """
 import math
-import os
 from pathlib import Path
 
 import numpy as np
@@ -13,6 +12,7 @@ import pandas as pd
 
 from . import labdata
 from .errors import ConfigError
+from .files import atomic_path
 
 G_M_S2 = 9.81
 
@@ -57,26 +57,40 @@ def rolling_resistance_from_aspect_ratio(aspect_ratio):
     return 0.5 * (aspect_ratio - 1.0)
 
 
-def impact_stress(drop_height_m, belt_speed_m_s, mass_flow_kg_s, bulk_density_kg_m3, g_m_s2=G_M_S2):
-    """Impact stress of a stream falling from a belt onto the receiving point.
+def min_drop_height_m(belt_speed_m_s, g_m_s2=G_M_S2):
+    """Lowest drop height (m) where the impact-stress rule holds: vz = v0, H = v0^2 / (2 g)."""
+    return belt_speed_m_s ** 2 / (2.0 * g_m_s2)
 
-    The stream leaves the belt horizontally at the belt speed v0 with bulk density
-    rho0 and falls H: vz = sqrt(2 g H), v = sqrt(v0^2 + vz^2). At constant mass flow
-    and cross-section rho_b v = rho0 v0, so rho_b = rho0 v0 / v. Impact stress
-    P = rho_b vz^2 sin^2(theta), theta = 90 deg, vertical velocity only.
-    Returns a dict (SI): impact_velocity_vertical_m_s, impact_speed_m_s,
-    stream_bulk_density_kg_m3, stream_area_m2 (= Q / (rho0 v0)), impact_stress_pa."""
+
+def impact_stress(drop_height_m, belt_speed_m_s, mass_flow_kg_s, bulk_density_kg_m3, g_m_s2=G_M_S2):
+    """Impact stress of a stream falling from a belt onto the receiving point (SI units).
+
+    The stream leaves the belt horizontally at the belt speed v0 (m/s) with bulk density
+    rho0 (kg/m3) and falls H (m): vertical velocity vz = sqrt(2 g H). Only the vertical
+    velocity counts: the stream keeps its cross-section and its mass flow while it
+    accelerates, so rho_b vz = rho0 v0 and rho_b = rho0 v0 / vz (kg/m3). Impact stress
+    P = rho_b vz^2 sin^2(theta) with theta = 90 deg, i.e. P = rho0 v0 vz (Pa).
+    The rule holds once the stream falls faster than it left the belt (vz >= v0, i.e.
+    H >= min_drop_height_m(v0) = v0^2 / (2 g)); below, it would make the stream denser
+    than on the belt, and a ValueError says so.
+    Returns a dict: impact_velocity_vertical_m_s, impact_speed_m_s (sqrt(v0^2 + vz^2),
+    for information only), stream_bulk_density_kg_m3, stream_area_m2 (= Q / (rho0 v0)),
+    impact_stress_pa."""
     for name, value in (("drop_height_m", drop_height_m), ("belt_speed_m_s", belt_speed_m_s),
                         ("mass_flow_kg_s", mass_flow_kg_s), ("bulk_density_kg_m3", bulk_density_kg_m3)):
         if not (math.isfinite(value) and value > 0):
             raise ValueError(f"{name} = {value} must be > 0")
     vz = math.sqrt(2.0 * g_m_s2 * drop_height_m)
-    v = math.hypot(belt_speed_m_s, vz)
-    rho_b = bulk_density_kg_m3 * belt_speed_m_s / v
+    h_min = min_drop_height_m(belt_speed_m_s, g_m_s2)
+    if drop_height_m < h_min:
+        raise ValueError(f"drop_height_m = {drop_height_m:g} is below v0^2 / (2 g) = {h_min:.3g} m at a belt "
+                         f"speed of {belt_speed_m_s:g} m/s: the stream would be denser than on the belt "
+                         "(rho_b = rho0 v0 / vz > rho0), the impact-stress rule does not apply")
+    rho_b = bulk_density_kg_m3 * belt_speed_m_s / vz
     theta = math.radians(90.0)
     return {
         "impact_velocity_vertical_m_s": vz,
-        "impact_speed_m_s": v,
+        "impact_speed_m_s": math.hypot(belt_speed_m_s, vz),
         "stream_bulk_density_kg_m3": rho_b,
         "stream_area_m2": mass_flow_kg_s / (bulk_density_kg_m3 * belt_speed_m_s),
         "impact_stress_pa": rho_b * vz ** 2 * math.sin(theta) ** 2,
@@ -84,9 +98,11 @@ def impact_stress(drop_height_m, belt_speed_m_s, mass_flow_kg_s, bulk_density_kg
 
 
 def impact_vs_drop_height(heights_m, belt_speed_m_s, mass_flow_kg_s, bulk_density_kg_m3):
-    """impact_stress() for each drop height (m), as a DataFrame with drop_height_m first."""
+    """impact_stress() for each drop height (m) from min_drop_height_m on (lower heights
+    are left out: the rule does not apply there), as a DataFrame with drop_height_m first."""
+    h_min = min_drop_height_m(belt_speed_m_s)
     rows = [{"drop_height_m": h, **impact_stress(h, belt_speed_m_s, mass_flow_kg_s, bulk_density_kg_m3)}
-            for h in heights_m]
+            for h in heights_m if h >= h_min]
     return pd.DataFrame(rows)
 
 
@@ -157,7 +173,7 @@ def derived_quantities(lab=None):
     units = {"_m_s": "m/s", "_kg_m3": "kg/m3", "_m2": "m2", "_pa": "Pa"}
     for k, v in imp.items():
         add(k, v, next(u for suf, u in units.items() if k.endswith(suf)),
-            "lab-tests.md section 9, design drop height, belt data, mine bulk density")
+            "P = rho0 v0 vz (docs/method.md), design drop height, belt data, mine bulk density")
     steps = [c["stress_pa"].max() for c in lab["curves"].values()]
     if steps:
         add("highest_lab_load_step_pa", max(steps), "Pa", "labresults/curves/*.csv")
@@ -179,34 +195,27 @@ def cli_impact(args):
     """`pycal impact`: print the impact numbers for one chute (units on every line)."""
     _check_positive(args, [("--drop-height-m", "drop_height_m"), ("--belt-speed-m-s", "belt_speed_m_s"),
                            ("--flow-t-h", "flow_t_h"), ("--bulk-density-kg-m3", "bulk_density_kg_m3")])
+    h_min = min_drop_height_m(args.belt_speed_m_s)
+    if args.drop_height_m < h_min:
+        raise ConfigError("--drop-height-m", "drop_height_m",
+                          f"{args.drop_height_m:g} m is below v0^2 / (2 g) = {h_min:.3g} m for a belt speed of "
+                          f"{args.belt_speed_m_s:g} m/s: the stream has not thinned yet, the impact-stress rule "
+                          "(rho_b = rho0 v0 / vz) does not apply")
     r = impact_stress(args.drop_height_m, args.belt_speed_m_s, t_h_to_kg_s(args.flow_t_h),
                       args.bulk_density_kg_m3)
     print(f"impact velocity (vertical): {r['impact_velocity_vertical_m_s']:.2f} m/s")
-    print(f"impact speed: {r['impact_speed_m_s']:.2f} m/s")
-    print(f"stream bulk density: {r['stream_bulk_density_kg_m3']:.1f} kg/m3")
+    print(f"impact speed (belt and vertical, not used): {r['impact_speed_m_s']:.2f} m/s")
+    print(f"stream bulk density (rho0 v0 / vz): {r['stream_bulk_density_kg_m3']:.1f} kg/m3")
     print(f"stream cross-section: {r['stream_area_m2']:.4f} m2")
-    print(f"impact stress: {r['impact_stress_pa'] / 1000:.2f} kPa")
+    print(f"impact stress (rho_b vz^2): {r['impact_stress_pa'] / 1000:.2f} kPa")
     return r
-
-
-def _replace_atomically(path, write):
-    """Call write(tmp_path), then rename tmp_path to path (no half-written file)."""
-    path = Path(path)
-    tmp = path.with_name(f".{path.name}.{os.getpid()}.tmp")
-    try:
-        write(tmp)
-        os.replace(tmp, path)
-    finally:
-        if tmp.exists():
-            tmp.unlink()
 
 
 def plot_impact(curve, design_h_m, design_p_pa, highest_step_pa, path, label="impact stress"):
     """PNG of impact stress (kPa) vs drop height (m), marking the design drop height
     (m) and its stress (Pa) and, if given, the highest lab load step (Pa)."""
-    from matplotlib.figure import Figure   # no pyplot: Agg canvas, no global state
-    fig = Figure(figsize=(6.4, 4.4))
-    ax = fig.add_subplot()
+    from .plotting import new_figure, save_png
+    fig, ax = new_figure(figsize=(6.4, 4.4))
     ax.plot(curve["drop_height_m"], curve["impact_stress_pa"] / 1000, "-", color="C0", label=label)
     ax.axvline(design_h_m, color="C3", ls="--", lw=1)
     ax.plot([design_h_m], [design_p_pa / 1000], "o", color="C3",
@@ -216,11 +225,11 @@ def plot_impact(curve, design_h_m, design_p_pa, highest_step_pa, path, label="im
                    label=f"highest lab load step {highest_step_pa / 1000:g} kPa")
     ax.set_xlabel("drop height (m)")
     ax.set_ylabel("impact stress (kPa)")
-    ax.set_title("Impact stress at the receiving point (lab-tests.md s. 9)")
+    ax.set_title("Impact stress at the receiving point: P = rho_b vz^2, rho_b = rho0 v0 / vz", fontsize=10)
     ax.grid(alpha=0.3)
     ax.legend(loc="upper left")
     fig.tight_layout()
-    _replace_atomically(path, lambda tmp: fig.savefig(tmp, format="png", dpi=120))
+    save_png(fig, path, dpi=120)
 
 
 def cli_analyse(args):
@@ -230,16 +239,16 @@ def cli_analyse(args):
     out = Path(args.out)
     out.mkdir(parents=True, exist_ok=True)
     table = derived_quantities(lab)
-    _replace_atomically(out / "derived_quantities.csv",
-                        lambda tmp: table.to_csv(tmp, index=False, float_format="%.6g"))
+    with atomic_path(out / "derived_quantities.csv") as tmp:
+        table.to_csv(tmp, index=False, float_format="%.6g")
 
     s = lab["samples"]
     belt, rho0, h = s["belt"], s["material"]["mine_bulk_density_kg_m3"], s["design"]["drop_height_m"]
     heights = np.round(np.arange(0.5, 15.0 + 1e-9, 0.5), 6)
     curve = impact_vs_drop_height(heights, belt["speed_m_s"], t_h_to_kg_s(belt["flow_t_h"]), rho0)
     curve = curve.drop(columns="stream_area_m2")
-    _replace_atomically(out / "impact_vs_drop_height.csv",
-                        lambda tmp: curve.to_csv(tmp, index=False, float_format="%.6g"))
+    with atomic_path(out / "impact_vs_drop_height.csv") as tmp:
+        curve.to_csv(tmp, index=False, float_format="%.6g")
     design = impact_stress(h, belt["speed_m_s"], t_h_to_kg_s(belt["flow_t_h"]), rho0)
     highest = max((c["stress_pa"].max() for c in lab["curves"].values()), default=None)
     label = (f"impact stress ({belt['flow_t_h']:g} t/h, {belt['speed_m_s']:g} m/s, "

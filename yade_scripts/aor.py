@@ -1,4 +1,4 @@
-"""Rig 2: cylinder-lift angle of repose (method.md rig 2, lab-tests.md section 4).
+"""Rig 2: cylinder-lift angle of repose (docs/rigs.md, docs/lab-tests.md section 4).
 
 Fill the 145 x 95 mm PVC cylinder standing on the steel table (rigs.fill_cell: pour,
 settle, strike level), lift the cylinder kinematically at lift_speed_m_s until its
@@ -16,24 +16,6 @@ from yade_scripts.demlib.scene import Scene
 from yade_scripts.demlib import rigs
 
 
-def build_pile(scene):
-    """Fill, lift, settle. Returns the timing/count entries of result.json and the cell dict."""
-    from yade import O
-    p = scene.rig["procedure"]
-    cell = rigs.fill_cell(scene)
-    lift = rigs.lift_cylinder(scene, cell["cylinder_ids"], p["lift_speed_m_s"], p["lift_clearance_m"])
-    t_settle, n_fallen = rigs.settle_pile(scene, "pile settle")
-    return {
-        "lift_time_s": lift["lift_time_s"],
-        "lift_height_m": lift["lift_height_m"],
-        "settle_time_s": t_settle,
-        "fill_settle_time_s": cell["settle_time_s"],
-        "n_fallen_off": lift["n_fallen"] + n_fallen,
-        "steps": O.iter,
-        "timestep_s": cell["timestep_s"],
-    }, cell
-
-
 def pile_result(scene, out_dir, info, prefix="aor", files="pile", title="AoR"):
     keys, m = rigs.measure_pile(scene, out_dir, prefix=prefix, files=files,
                                 title=f"{title} {scene.material} seed {scene.job['seed']}")
@@ -46,7 +28,7 @@ def pile_result(scene, out_dir, info, prefix="aor", files="pile", title="AoR"):
 
 def main(job, out_dir):
     scene = Scene(job)
-    info, _ = build_pile(scene)
+    info, _ = rigs.cylinder_lift_pile(scene)
     return pile_result(scene, out_dir, info)
 
 

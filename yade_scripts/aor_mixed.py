@@ -1,5 +1,5 @@
 """Rig 2 for a material set: cylinder-lift angle of repose of a mixed sample (M1 clumps
-+ M2 + M3 spheres, lab-tests.md section 4: the -50 mm sample).
++ M2 + M3 spheres, docs/lab-tests.md section 4: the -50 mm sample).
 
 Fill the 145 x 95 mm PVC cylinder on the steel table with the set's particles by mass
 (demlib.mixed: generated mass split by the components' mass fractions and the M1
@@ -20,22 +20,12 @@ from yade_scripts.demlib import mixed, rigs
 
 
 def build_pile(scene):
-    """Fill, lift, settle. Returns the entries of result.json about the run."""
-    from yade import O
-    p = scene.rig["procedure"]
-    cell = mixed.fill_cell_mixed(scene)
-    lift = rigs.lift_cylinder(scene, cell["cylinder_ids"], p["lift_speed_m_s"], p["lift_clearance_m"])
-    t_settle, n_fallen = rigs.settle_pile(scene, "pile settle")
+    """Fill by mass, lift, settle (demlib.rigs.cylinder_lift_pile). Returns the entries of
+    result.json about the run: the fill's masses and fractions, timings and counts."""
+    pile, cell = rigs.cylinder_lift_pile(scene, mixed.fill_cell_mixed)
     info = {k: v for k, v in cell.items() if k not in ("cylinder_ids", "table_ids", "settle_time_s", "steps")}
-    info.update({
-        "lift_time_s": lift["lift_time_s"],
-        "lift_height_m": lift["lift_height_m"],
-        "settle_time_s": t_settle,
-        "fill_settle_time_s": cell["settle_time_s"],
-        "n_fallen_off": lift["n_fallen"] + n_fallen,
-        "n_clumps_in_pile": len(scene.clumps),
-        "steps": O.iter,
-    })
+    info.update(pile)
+    info["n_clumps_in_pile"] = len(scene.clumps)
     return info
 
 
@@ -46,15 +36,13 @@ def main(job, out_dir):
     rows = scene.particle_rows()
     write_csv(out_dir, "pile_particles.csv", ["x_m", "y_m", "z_m", "radius_m", "material", "clump_id"], rows)
     whole, upper = post.measure(rows, scene.rig["measure"])
-    columns = ["sector", "r_edge_m", "z_m", "used_in_fit"]        # as demlib.rigs.measure_pile
-    write_csv(out_dir, "pile_profile.csv", columns, aor_post.profile_rows(whole))
-    write_csv(out_dir, "pile_upper_profile.csv", columns, aor_post.profile_rows(upper))
+    write_csv(out_dir, "pile_profile.csv", aor_post.PROFILE_COLUMNS, aor_post.profile_rows(whole))
+    write_csv(out_dir, "pile_upper_profile.csv", aor_post.PROFILE_COLUMNS, aor_post.profile_rows(upper))
     lift_mm_s = 1000 * scene.rig["procedure"]["lift_speed_m_s"]
-    try:
-        post.plot(rows, whole, upper, os.path.join(out_dir, "pile_side.png"),
-                  title=f"AoR {scene.material} seed {job['seed']} (lift {lift_mm_s:g} mm/s)")
-    except Exception as exc:  # a figure must not cost the run
-        print(f"warning: pile_side.png not drawn: {exc}", flush=True)
+    post.plot(rows, whole, upper, os.path.join(out_dir, "pile_side.png"),
+              title=f"AoR {scene.material} seed {job['seed']} (lift {lift_mm_s:g} mm/s)")
+    for line in post.missing_angles(whole, upper):
+        print(line, flush=True)
     out = post.result_keys(whole, upper)
     out.update({"n_particles": whole["n_particles"], "pile_height_m": whole["pile_height_m"],
                 "pile_radius_m": whole["pile_radius_m"]})

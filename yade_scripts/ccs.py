@@ -1,4 +1,4 @@
-"""Rig 4a: confined compression (CCS) in the 145 x 95 mm cell (method.md rig 4).
+"""Rig 4a: confined compression (CCS) in the 145 x 95 mm cell (docs/rigs.md).
 
 Fill the cell (pour, strike level, settle: demlib.rigs.fill_cell), put the steel plate
 procedure.plate_start_gap_m above the highest particle top, then for each of

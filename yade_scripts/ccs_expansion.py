@@ -1,5 +1,5 @@
 """Rig 4b: CCS expansion - load the confined cell high, then release it in steps
-(method.md rig 4, lab-tests.md section 8: the lab's particle-stiffness estimate).
+(docs/rigs.md, docs/lab-tests.md section 8: the lab's particle-stiffness estimate).
 
 Same cell, plate, servo and per-step record as ccs.py (demlib.compression); the load
 steps procedure.load_steps_pa (branch 'loading') are followed by

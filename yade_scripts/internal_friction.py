@@ -1,4 +1,4 @@
-"""Rig 6: internal friction (method.md rig 6, lab-tests.md sections 8-9).
+"""Rig 6: internal friction (docs/rigs.md, docs/lab-tests.md sections 8-9).
 
 A fixed PVC cell stands on the steel table; a mobile cell (a rigid clump of
 cell_mass_kg) is stacked on it with a gap of cell_gap_m, so the shear plane runs
@@ -13,30 +13,25 @@ even at max_tilt_deg (90), the step reports sticks: true and the largest angle.
 There is no plate force here: only tan(angle) is recorded.
 Run: yade -j1 -x -n yade_scripts/internal_friction.py job.json
 """
-import math
-
 from yade_scripts.demlib.jobio import run_rig
 from yade_scripts.demlib import tilt as tl
+from yade_scripts.demlib.tilt_bodies import add_bearing_plate
 
 
 def build(scene):
+    """Square table, the fixed cell on it, the mobile cell cell_gap_m above, pour (column =
+    pour_height_factor x the height of both cells and the gap), strike at the mobile rim;
+    contents volume = both cells and the gap. No plate force (the table is not read)."""
     g, p = scene.rig["geometry"], scene.rig["procedure"]
     d, h, gap = g["cell_inner_diameter_m"], g["cell_height_m"], g["cell_gap_m"]
     half = g["table_half_width_m"]
-    tl.add_bearing_plate(scene, -half, half, half, g["table_material"])
+    add_bearing_plate(scene, -half, half, half, g["table_material"])
     scene.add_cylinder(d, h, g["cell_facet_segments_count"], g["cell_material"], z0=0.0)   # fixed cell
     mobile_bottom = h + gap
-    cell = tl.add_rigid_cell(scene, d, h, g["cell_facet_segments_count"], g["cell_material"], mobile_bottom,
-                             g["cell_mass_kg"])
-    cell.hold(True)
     top = mobile_bottom + h
-    column = p["pour_height_factor"] * top
-    scene.set_domain((-half, -half, -0.05), (half, half, column + 0.1))
-    settle_s = tl.pour_and_strike(scene, d, 0.0, top, column, p["pour_porosity_ratio"],
-                                  g["cell_facet_segments_count"], g["cell_material"], p["strike_level_height_m"])
-    return {"plate_ids": [], "cell": cell, "settle_time_s": settle_s, "cell_bottom_z_m": mobile_bottom,
-            "floor_z_m": mobile_bottom, "spill_box_m": (-half, half, -half, half, -2.0 * scene.radius),
-            "contents_volume_m3": math.pi * d * d / 4.0 * top}
+    return tl.build_sliding_cell(scene, [], cell_bottom_z=mobile_bottom, fill_top_z=top,
+                                 column_m=p["pour_height_factor"] * top, box_xy=(-half, half, -half, half),
+                                 floor_z=mobile_bottom, contents_height_m=top)
 
 
 def main(job, out_dir):

@@ -1,4 +1,4 @@
-"""Rig 3: surcharge angle after vibration (method.md rig 3, lab-tests.md section 5).
+"""Rig 3: surcharge angle after vibration (docs/rigs.md, docs/lab-tests.md section 5).
 
 Same as the AoR rig up to the settled pile and its angles (aor_* keys, pile_*.csv),
 then the table facets move kinematically on an ellipse (x = A_h sin wt,
@@ -18,7 +18,7 @@ def main(job, out_dir):
     from yade import O
     scene = Scene(job)
     p = scene.rig["procedure"]
-    info, cell = aor.build_pile(scene)
+    info, cell = rigs.cylinder_lift_pile(scene)
     out = aor.pile_result(scene, out_dir, info)
     vib = rigs.vibrate_table(scene, cell["table_ids"], p["vibration_frequency_hz"],
                              p["vibration_amplitude_horizontal_m"], p["vibration_amplitude_vertical_m"],

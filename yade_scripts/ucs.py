@@ -1,8 +1,8 @@
 """Rig 4c: unconfined compression (UCS) - a pile formed as in the AoR test, pressed by
-the steel plate, material free to move sideways (method.md rig 4).
+the steel plate, material free to move sideways (docs/rigs.md).
 
-Fill the cylinder on the table (rigs.fill_cell), lift it at lift_speed_m_s until clear
-(rigs.lift_cylinder, cylinder erased), settle the pile (rigs.settle_pile), then a
+Fill the cylinder on the table, lift it at lift_speed_m_s until clear and settle the
+pile as the AoR rig does (rigs.cylinder_lift_pile), then a
 circular steel plate of geometry.plate_diameter_m (a 32-gon of the same area, demlib
 .loading.add_plate fit='equal_area') starts plate_start_gap_m above the pile top and is
 servoed through procedure.load_steps_pa (demlib.loading, same rule as CCS).
@@ -34,9 +34,7 @@ PLATE_SEGMENTS = 32   # polygon of the circular plate (equal area: the stress ar
 def main(job, out_dir):
     scene = Scene(job)
     g, p = scene.rig["geometry"], scene.rig["procedure"]
-    cell = rigs.fill_cell(scene)
-    lift = rigs.lift_cylinder(scene, cell["cylinder_ids"], p["lift_speed_m_s"], p["lift_clearance_m"])
-    t_settle, n_fallen = rigs.settle_pile(scene, "pile settle")
+    pile, cell = rigs.cylinder_lift_pile(scene)
     d = g["plate_diameter_m"]
     area = math.pi * d * d / 4.0
     h0 = compression.top_of_bulk(scene)
@@ -44,7 +42,7 @@ def main(job, out_dir):
                             segments=PLATE_SEGMENTS, fit="equal_area")
     plate = loading.ServoPlate(scene, ids, area, p["plate_speed_max_m_s"], p["servo_relaxation_time_s"],
                                p["servo_control_interval_s"], floor_z=0.0, footprint_radius_m=d / 2.0)
-    fallen = [n_fallen + lift["n_fallen"]]
+    fallen = [pile["n_fallen_off"]]
 
     def erase_fallen(t):
         fallen[0] += rigs.remove_fallen(scene, -2.0 * scene.radius)
@@ -70,8 +68,8 @@ def main(job, out_dir):
             print(f"UCS loading stopped before {target:g} Pa: {exc}", flush=True)
             break
     extra = {"reference_area_m2": area, "fill_settle_time_s": cell["settle_time_s"],
-             "timestep_s": cell["timestep_s"], "lift_time_s": lift["lift_time_s"],
-             "pile_settle_time_s": t_settle, "pile_height_m": h0, "n_fallen_off": fallen[0],
+             "timestep_s": cell["timestep_s"], "lift_time_s": pile["lift_time_s"],
+             "pile_settle_time_s": pile["settle_time_s"], "pile_height_m": h0, "n_fallen_off": fallen[0],
              "initial_bulk_density_kg_m3": pile_mass / pile_volume,
              "load_steps_completed_count": len(rec.data["stress_pa"]), **stop,
              "strain_reference": "h0 = pile top before loading (plate first-contact height)",

@@ -1,4 +1,4 @@
-"""Rig 5: tilt-table wall friction (method.md rig 5, lab-tests.md sections 8-9).
+"""Rig 5: tilt-table wall friction (docs/rigs.md, docs/lab-tests.md sections 8-9).
 
 The filled cell (a rigid clump of PVC facets standing cell_gap_to_plate_m above the
 steel bearing plate, so only the material touches the plate) carries a steel lid.
@@ -12,29 +12,21 @@ consolidation history grows from step to step):
 The plate's tangential / normal force is recorded too (at onset and while sliding).
 Run: yade -j1 -x -n yade_scripts/wall_friction.py job.json
 """
-import math
-
 from yade_scripts.demlib.jobio import run_rig
 from yade_scripts.demlib import tilt as tl
+from yade_scripts.demlib.tilt_bodies import add_bearing_plate
 
 
 def build(scene):
+    """Bearing plate, the cell cell_gap_to_plate_m above it, pour (column = pour_height_factor
+    x cell height), strike at the rim; contents volume = the cell's (pi D^2 / 4 x H)."""
     g, p = scene.rig["geometry"], scene.rig["procedure"]
-    d, h, gap = g["cell_inner_diameter_m"], g["cell_height_m"], g["cell_gap_to_plate_m"]
-    plate = tl.add_bearing_plate(scene, -g["plate_back_length_m"], g["plate_front_length_m"],
-                                 g["plate_half_width_m"], g["plate_material"])
-    cell = tl.add_rigid_cell(scene, d, h, g["cell_facet_segments_count"], g["cell_material"], gap,
-                             g["cell_mass_kg"])
-    cell.hold(True)
-    column = p["pour_height_factor"] * h
-    scene.set_domain((-g["plate_back_length_m"], -g["plate_half_width_m"], -0.05),
-                     (g["plate_front_length_m"], g["plate_half_width_m"], column + 0.1))
-    settle_s = tl.pour_and_strike(scene, d, 0.0, gap + h, column, p["pour_porosity_ratio"],
-                                  g["cell_facet_segments_count"], g["cell_material"], p["strike_level_height_m"])
-    spill_box = (-g["plate_back_length_m"], g["plate_front_length_m"], -g["plate_half_width_m"],
-                 g["plate_half_width_m"], -2.0 * scene.radius)
-    return {"plate_ids": list(plate), "cell": cell, "settle_time_s": settle_s, "cell_bottom_z_m": gap,
-            "floor_z_m": 0.0, "spill_box_m": spill_box, "contents_volume_m3": math.pi * d * d / 4.0 * h}
+    h, gap = g["cell_height_m"], g["cell_gap_to_plate_m"]
+    back, front, half = g["plate_back_length_m"], g["plate_front_length_m"], g["plate_half_width_m"]
+    plate = add_bearing_plate(scene, -back, front, half, g["plate_material"])
+    return tl.build_sliding_cell(scene, plate, cell_bottom_z=gap, fill_top_z=gap + h,
+                                 column_m=p["pour_height_factor"] * h, box_xy=(-back, front, -half, half),
+                                 floor_z=0.0, contents_height_m=h)
 
 
 def main(job, out_dir):

@@ -1,6 +1,8 @@
 """Post-processing of rig results: summaries, statistics over seeds.
 
-Rig-specific modules: aor (pile angles), compression (spring curves), friction (tilt records).
+Rig-specific modules: aor and aor_mixed (pile angles), compression (spring curves),
+friction (tilt records); lab_curves (lab targets and misfits, shared), cli (the shared
+command line of the modules).
 """
 import math
 
@@ -14,8 +16,10 @@ def scalar_measurements(result):
 
 
 def summary_line(result):
-    """One line of the scalar measurements of a result."""
-    return ", ".join(f"{k}={v:.4g}" for k, v in scalar_measurements(result).items())
+    """One line of the scalar measurements of a result (keys with no value: '=none')."""
+    parts = [f"{k}={v:.4g}" for k, v in scalar_measurements(result).items()]
+    parts += [f"{k}=none" for k, v in sorted(result.items()) if v is None and k.endswith("_deg")]
+    return ", ".join(parts)
 
 
 def mean_std(values):
@@ -28,18 +32,22 @@ def mean_std(values):
 
 
 def seed_statistics(results):
-    """{measurement: (mean, std, n)} over several results (seeds) of the same job."""
-    keys = set.intersection(*(set(scalar_measurements(r)) for r in results))
+    """{measurement: (mean, std, n)} over several results (seeds) of the same job: per key
+    the seeds that have a value (a null / NaN measurement, e.g. an AoR sector without an
+    angle, is left out and n says so)."""
+    per_seed = [scalar_measurements(r) for r in results]
     out = {}
-    for k in sorted(keys):
-        vals = [scalar_measurements(r)[k] for r in results]
-        m, s = mean_std(vals)
-        out[k] = (m, s, len(vals))
+    for k in sorted(set().union(*per_seed)):
+        vals = [m[k] for m in per_seed if k in m and not math.isnan(m[k])]
+        if vals:
+            m, s = mean_std(vals)
+            out[k] = (m, s, len(vals))
     return out
 
 
 def seed_statistics_text(results):
     lines = [f"over {len(results)} seeds (mean +/- std):"]
     for k, (m, s, n) in seed_statistics(results).items():
-        lines.append(f"  {k}: {m:.4g} +/- {s:.2g}")
+        lines.append(f"  {k}: {m:.4g} +/- {s:.2g}" + (f"  ({n} of {len(results)} seeds have a value)"
+                                                     if n < len(results) else ""))
     return "\n".join(lines)

@@ -1,7 +1,7 @@
 """Pile angles of the cylinder-lift angle of repose and surcharge rigs (pure Python).
 
 Imported by the rig scripts inside YADE and by the tests: numpy, matplotlib (only in
-plot_pile, Agg backend) and the standard library only, never yade.
+plot_pile, through pycal.plotting) and the standard library only, never yade.
 
 Input: particle positions [(x, y, z, r), ...] in m, the table top at z = table_z_m (0).
 
@@ -19,7 +19,10 @@ Method - the pile's silhouette, as a gauge laid on the flank sees it
 5. Least-squares line r_edge = a + b z through the used points (r as a function of
    height, so that a vertical flank, b = 0, is well posed); angle = atan(-1 / b) for
    b < 0 and 90 degrees for b >= 0 (a vertical or overhanging flank). Fewer than 2
-   used slices: no angle (0, and n_used says so).
+   used slices: no angle (NaN in Python, null in result.json; n_used says why).
+   The mean angle is the mean over the sectors that have an angle (NaN if none);
+   `sectors_count` says how many: a sector without an angle is reported, never
+   counted as 0 degrees.
 6. pile_height_m = highest particle top - table_z_m; pile_radius_m = largest horizontal
    distance of a particle edge from the pile centre.
 
@@ -33,10 +36,11 @@ Known limits: the centre is the mass centre, not the apex, so on an asymmetric p
 it moves towards the flatter side; a pile of ~4 layers of 25 mm spheres gives only
 ~4-6 silhouette points per sector: angles are noisy, repeat seeds.
 """
-import csv
 import math
 
 import numpy as np
+
+from ..files import write_csv
 
 SECTORS = (("left", 180.0), ("right", 0.0), ("front", -90.0), ("back", 90.0))
 
@@ -78,7 +82,7 @@ def fit_silhouette(points, z_lo_m, z_hi_m):
     angle_deg, n_used, points [(r, z, used)], line [(r0, z0), (r1, z1)] or None."""
     pts = [(r, z, z_lo_m <= z <= z_hi_m) for z, r in points]
     used = [(r, z) for r, z, u in pts if u]
-    fit = {"angle_deg": 0.0, "n_used": len(used), "points": pts, "line": None}
+    fit = {"angle_deg": math.nan, "n_used": len(used), "points": pts, "line": None}
     if len(used) < 2:
         return fit
     rs, zs = np.array([p[0] for p in used]), np.array([p[1] for p in used])
@@ -92,8 +96,9 @@ def fit_silhouette(points, z_lo_m, z_hi_m):
 def measure_pile(positions, slice_height_m, exclude_bottom_m, exclude_apex_m, half_width_deg,
                  table_z_m=0.0):
     """Angles of the four sectors and the pile size. Returns dict with
-    'angles' {sector: deg}, 'mean_deg', 'fits' {sector: fit_silhouette dict}, 'centre',
-    'n_particles', 'pile_height_m', 'pile_radius_m'."""
+    'angles' {sector: deg, NaN = no angle}, 'mean_deg' (over the sectors with an angle,
+    NaN if none), 'sectors_count' (sectors with an angle), 'fits' {sector:
+    fit_silhouette dict}, 'centre', 'n_particles', 'pile_height_m', 'pile_radius_m'."""
     a = as_array(positions)
     if len(a) == 0:
         raise ValueError("no particles to measure")
@@ -104,10 +109,12 @@ def measure_pile(positions, slice_height_m, exclude_bottom_m, exclude_apex_m, ha
         sil = sector_silhouette(a, centre, axis, half_width_deg, slice_height_m)
         fits[name] = fit_silhouette(sil, table_z_m + exclude_bottom_m, top - exclude_apex_m)
     angles = {k: f["angle_deg"] for k, f in fits.items()}
+    measured = [v for v in angles.values() if not math.isnan(v)]
     rh = np.hypot(a[:, 0] - centre[0], a[:, 1] - centre[1]) + a[:, 3]
     return {
         "angles": angles,
-        "mean_deg": float(sum(angles.values()) / len(angles)),
+        "mean_deg": float(sum(measured) / len(measured)) if measured else math.nan,
+        "sectors_count": len(measured),
         "fits": fits,
         "centre": centre,
         "n_particles": int(len(a)),
@@ -122,11 +129,26 @@ def measure_from_config(positions, measure_cfg, table_z_m=0.0):
                         measure_cfg["exclude_apex_m"], measure_cfg["sector_half_width_deg"], table_z_m)
 
 
+def _json_angle(v):
+    """An angle for result.json: None (null) where there is none (JSON has no NaN)."""
+    return None if math.isnan(v) else float(v)
+
+
 def result_keys(m, prefix="aor"):
-    """{prefix_left_deg, ..., prefix_mean_deg} of a measure_pile result."""
-    out = {f"{prefix}_{k}_deg": float(v) for k, v in m["angles"].items()}
-    out[f"{prefix}_mean_deg"] = m["mean_deg"]
+    """{prefix_left_deg, ..., prefix_mean_deg, prefix_sectors_count} of a measure_pile
+    result; a sector without an angle is None (null), and so is the mean if no sector
+    has one."""
+    out = {f"{prefix}_{k}_deg": _json_angle(v) for k, v in m["angles"].items()}
+    out[f"{prefix}_mean_deg"] = _json_angle(m["mean_deg"])
+    out[f"{prefix}_sectors_count"] = m["sectors_count"]
     return out
+
+
+def missing_angles(m, prefix="aor"):
+    """One warning line per sector without an angle (empty list if every sector has one)."""
+    return [f"warning: {prefix} {k}: no angle ({m['fits'][k]['n_used']} silhouette slice(s) between the "
+            f"first layer and the top, 2 needed): left out of {prefix}_mean_deg"
+            for k, _ in SECTORS if math.isnan(m["angles"][k])]
 
 
 def profile_rows(m):
@@ -138,28 +160,28 @@ def profile_rows(m):
     return rows
 
 
+PROFILE_COLUMNS = ["sector", "r_edge_m", "z_m", "used_in_fit"]
+
+
 def write_profile_csv(m, path):
-    with open(path, "w", newline="") as f:
-        w = csv.writer(f)
-        w.writerow(["sector", "r_edge_m", "z_m", "used_in_fit"])
-        w.writerows(profile_rows(m))
+    """pile_profile.csv: the silhouette points of every sector (atomic)."""
+    return write_csv(path, PROFILE_COLUMNS, profile_rows(m))
 
 
 def read_positions_csv(path):
     """pile_particles.csv -> array of (x, y, z, r)."""
+    import csv
     with open(path) as f:
         rows = list(csv.DictReader(f))
     return np.array([[float(r["x_m"]), float(r["y_m"]), float(r["z_m"]), float(r["radius_m"])] for r in rows])
 
 
-def plot_pile(positions, fits, path, title=None, centre=None):
+def pile_figure(positions, fits, title=None, centre=None):
     """Side view (x-z plane) of the particles as circles, with the fitted left and right
-    lines and the angles in the title. fits: measure_pile(...)['fits'] (or the whole
-    measure_pile result)."""
-    import matplotlib
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
+    lines (labelled '<side> <angle> deg') and the angles in the title. fits:
+    measure_pile(...)['fits'] (or the whole measure_pile result). Returns the Figure."""
     from matplotlib.patches import Circle
+    from ..plotting import new_figure
 
     if "fits" in fits:
         centre = centre or fits.get("centre")
@@ -168,7 +190,7 @@ def plot_pile(positions, fits, path, title=None, centre=None):
     if centre is None:
         centre = pile_centre(a)
     cx = centre[0]
-    fig, ax = plt.subplots(figsize=(8, 4))
+    fig, ax = new_figure(figsize=(8, 4))
     for x, _, z, r in a:
         ax.add_patch(Circle((x, z), r, facecolor="0.75", edgecolor="0.3", lw=0.5))
     for name, sign, colour in (("left", -1.0, "tab:blue"), ("right", 1.0, "tab:red")):
@@ -190,6 +212,10 @@ def plot_pile(positions, fits, path, title=None, centre=None):
     ax.set_ylabel("z (m)")
     ax.legend(loc="upper right", fontsize=8)
     fig.tight_layout()
-    fig.savefig(path, dpi=110)
-    plt.close(fig)
-    return path
+    return fig
+
+
+def plot_pile(positions, fits, path, title=None, centre=None):
+    """pile_figure() written as a PNG (atomic). Returns path."""
+    from ..plotting import save_png
+    return save_png(pile_figure(positions, fits, title, centre), path)

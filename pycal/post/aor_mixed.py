@@ -8,9 +8,10 @@ upper_silhouette_slice_height_m between upper_fit_from_height_fraction x pile he
 and upper_exclude_apex_m below the highest particle top. A dihedral pile (steep top,
 shallow flanks) reads a larger upper angle than whole-slope angle; a straight cone
 about the same. The upper half of a ~9 cm pile of 25 mm spheres holds 1 - 2 spheres
-per sector, so the upper angle is much noisier than the whole-slope one; a sector with
-fewer than 2 slices there has no upper angle (0 in its key, left out of
-aor_upper_mean_deg; aor_upper_sectors_count = the sectors that have one).
+per sector, so the upper angle is much noisier than the whole-slope one. The rule of
+pycal.post.aor holds for both: a sector with fewer than 2 slices has no angle (null in
+its key, left out of the mean; aor_sectors_count and aor_upper_sectors_count say how
+many sectors have one).
 
 Input rows: (x, y, z, radius, material, clump id or -1), m.
 """
@@ -38,28 +39,25 @@ def measure(rows, measure_cfg, table_z_m=0.0):
 
 
 def result_keys(whole, upper, prefix="aor"):
-    """{aor_left_deg, ..., aor_mean_deg, aor_upper_left_deg, ..., aor_upper_mean_deg (over the
-    sectors with an upper fit), aor_upper_sectors_count}."""
-    out = aor.result_keys(whole, prefix)
-    fitted = [k for k, f in upper["fits"].items() if f["n_used"] >= 2]
-    for k, _ in aor.SECTORS:
-        out[f"{prefix}_upper_{k}_deg"] = float(upper["angles"][k]) if k in fitted else 0.0
-    out[f"{prefix}_upper_mean_deg"] = float(np.mean([upper["angles"][k] for k in fitted])) if fitted else 0.0
-    out[f"{prefix}_upper_sectors_count"] = len(fitted)
-    return out
+    """{aor_left_deg, ..., aor_mean_deg, aor_sectors_count, aor_upper_left_deg, ...,
+    aor_upper_mean_deg, aor_upper_sectors_count}: pycal.post.aor.result_keys of both."""
+    return {**aor.result_keys(whole, prefix), **aor.result_keys(upper, f"{prefix}_upper")}
+
+
+def missing_angles(whole, upper, prefix="aor"):
+    """Warning lines of the sectors without an angle, whole slope and upper part."""
+    return aor.missing_angles(whole, prefix) + aor.missing_angles(upper, f"{prefix}_upper")
 
 
 def plot(rows, whole, upper, path, title=None):
     """Side view (x-z) of every particle sphere coloured by material (M1 clump members
     dark grey), the whole-slope fits (solid) and the upper-part fits (dashed) of the
     left and right sectors."""
-    import matplotlib
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
     from matplotlib.patches import Circle
+    from ..plotting import new_figure, save_png
 
     cx = whole["centre"][0]
-    fig, ax = plt.subplots(figsize=(8, 4.2))
+    fig, ax = new_figure(figsize=(8, 4.2))
     # seen from the front (-y): the back (large y) is drawn first, the front on top
     for x, _, z, r, mat, cid in sorted(rows, key=lambda q: -float(q[1])):
         lump = int(cid) >= 0
@@ -90,6 +88,4 @@ def plot(rows, whole, upper, path, title=None):
     ax.set_ylabel("z (m)")
     ax.legend(loc="upper right", fontsize=7, ncol=2)
     fig.tight_layout()
-    fig.savefig(path, dpi=110)
-    plt.close(fig)
-    return path
+    return save_png(fig, path)

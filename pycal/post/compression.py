@@ -19,20 +19,17 @@ Definitions (stated once, used by every rig):
   the downward friction force the particles put on the cell wall (weight of the step
   when `step_weight_n` is recorded).
 
-Lab comparison: misfit of a simulated curve against a lab target curve
-(labresults/curves/<rig>_<sample>.csv, pycal.labdata.target_curve) = RMS over the lab
-stress steps of z = (sim - target) / (band half width on the side of sim), i.e.
-(target_high - target) above the target, (target - target_low) below it: |z| <= 1
-means inside the band. The simulated curve is interpolated linearly in log(stress)
-to the lab steps; lab steps outside the simulated stress range (beyond
-EXTRAPOLATE_RATIO) are left out and counted.
+Lab comparison: the misfit of pycal.post.lab_curves (RMS of the band z over the lab
+steps of labresults/curves/<rig>_<sample>.csv, the simulated curve interpolated in
+log stress).
 """
-import json
 import math
 import os
-import sys
 
-EXTRAPOLATE_RATIO = 0.05   # lab steps up to 5 % beyond the simulated stress range use the end segment
+from ..files import write_csv
+from .lab_curves import (EXTRAPOLATE_RATIO, band_z, interp_log_stress, lab_sample_of,  # noqa: F401 (API)
+                         misfit, write_comparison_csv)
+from . import lab_curves
 
 # columns of spring_curve.csv: (result.json key, CSV column with unit)
 CURVE_COLUMNS = [
@@ -116,61 +113,6 @@ def derived_arrays(result):
 
 # ------------------------------------------------------------------ lab comparison
 
-def interp_log_stress(stress, values, at, extrapolate_ratio=EXTRAPOLATE_RATIO):
-    """Value of the piecewise-linear curve (log stress, value) at stress `at`; None when
-    `at` is farther than extrapolate_ratio outside the range or no usable point exists.
-    Points with value None are skipped; stresses must be > 0."""
-    pts = sorted((math.log(s), v) for s, v in zip(stress, values) if v is not None and s > 0)
-    if not pts or at <= 0:
-        return None
-    x = math.log(at)
-    if len(pts) == 1:
-        return pts[0][1] if abs(x - pts[0][0]) <= math.log1p(extrapolate_ratio) else None
-    lo, hi = pts[0][0], pts[-1][0]
-    if x < lo - math.log1p(extrapolate_ratio) or x > hi + math.log1p(extrapolate_ratio):
-        return None
-    for k in range(len(pts) - 1):
-        (x0, y0), (x1, y1) = pts[k], pts[k + 1]
-        if x <= x1 or k == len(pts) - 2:
-            if x1 == x0:
-                return 0.5 * (y0 + y1)
-            return y0 + (y1 - y0) * (x - x0) / (x1 - x0)
-    return None  # pragma: no cover
-
-
-def band_z(sim, value, low, high):
-    """(sim - value) / half width of the band on the side of sim (|z| <= 1: inside)."""
-    if sim >= value:
-        w = high - value
-    else:
-        w = value - low
-    if w <= 0:
-        w = max(abs(value) * 1e-6, 1e-300)
-    return (sim - value) / w
-
-
-def misfit(sim_stress, sim_values, lab_stress, lab_value, lab_low, lab_high,
-           extrapolate_ratio=EXTRAPOLATE_RATIO):
-    """Scalar misfit of a simulated curve against a lab curve with band.
-
-    Returns {'rms_z', 'z', 'sim_at_lab', 'n_points', 'n_skipped', 'inside_band_count'}:
-    z per lab step (None where skipped), RMS of the usable z (None if none)."""
-    zs, sims = [], []
-    for s, v, lo, hi in zip(lab_stress, lab_value, lab_low, lab_high):
-        if v is None or (isinstance(v, float) and math.isnan(v)):
-            zs.append(None)
-            sims.append(None)
-            continue
-        sim = interp_log_stress(sim_stress, sim_values, s, extrapolate_ratio)
-        sims.append(sim)
-        zs.append(None if sim is None else band_z(sim, float(v), float(lo), float(hi)))
-    used = [z for z in zs if z is not None]
-    return {"rms_z": math.sqrt(sum(z * z for z in used) / len(used)) if used else None,
-            "z": zs, "sim_at_lab": sims, "n_points": len(used),
-            "n_skipped": len(zs) - len(used),
-            "inside_band_count": sum(1 for z in used if abs(z) <= 1.0)}
-
-
 # which simulated array is compared with which lab column, per rig:
 # (name of the misfit, simulated key, lab quantity, factor applied to the lab values, branch)
 COMPARISONS = {
@@ -190,29 +132,17 @@ def lab_curve_name(rig, lab_sample):
 
 
 def load_targets(rig, lab_sample, lab_dir=None):
-    """{lab quantity: (stress, value, low, high)} of the lab curve for this rig and sample,
-    plus '_particle_density' (kg/m3 of the lab material) and '_name'; {} if there is none.
-    For ccs_expansion the loading-branch targets come from the ccs curve."""
-    try:
-        from .. import labdata
-    except ImportError:      # pragma: no cover - labdata needs pandas
-        return {}
-    kw = {} if lab_dir is None else {"lab_dir": lab_dir}
-    out = {}
-    names = labdata.curve_names(**kw)
-    for name in (lab_curve_name(rig, lab_sample),) + (
-            (lab_curve_name("ccs", lab_sample),) if rig == "ccs_expansion" else ()):
-        if name not in names:
-            continue
-        df = labdata.load_curve(name, **kw)
-        for q in labdata.curve_quantities(df):
-            if q in out:
-                continue
-            t = labdata.target_curve(name, q, **kw)
-            out[q] = ([float(x) for x in t.stress_pa], [float(x) for x in t.value],
-                      [float(x) for x in t.low], [float(x) for x in t.high])
-        out.setdefault("_name", name)
+    """Targets (pycal.post.lab_curves form) of the lab curve <rig>_<lab_sample>, plus
+    '_particle_density' (kg/m3, labresults/samples.yaml: lab solid fractions become bulk
+    densities); for ccs_expansion the loading-branch quantities come from the ccs curve
+    of the sample. {} when there is no such curve."""
+    from .. import labdata
+    names = [lab_curve_name(rig, lab_sample)]
+    if rig == "ccs_expansion":
+        names.append(lab_curve_name("ccs", lab_sample))
+    out = lab_curves.load_targets(names, lab_dir)
     if out:
+        kw = {} if lab_dir is None else {"lab_dir": lab_dir}
         out["_particle_density"] = float(labdata.load_samples(**kw)["material"]["particle_density_kg_m3"])
     return out
 
@@ -227,10 +157,11 @@ def compare(result, targets):
     for name, key, quantity, factor, br in COMPARISONS.get(result["rig"], []):
         if quantity not in targets or key not in result:
             continue
-        stress, value, low, high = targets[quantity]
+        t = targets[quantity]
+        stress, value, low, high = t["stress_pa"], t["value"], t["low"], t["high"]
         if factor == "lab_particle_density":
             f = targets["_particle_density"]
-            value, low, high = [v * f for v in value], [v * f for v in low], [v * f for v in high]
+            value, low, high = ([None if v is None else v * f for v in a] for a in (value, low, high))
         idx = [i for i, b in enumerate(branch) if b == br]
         if not idx:
             continue
@@ -246,31 +177,16 @@ def compare(result, targets):
 
 def write_curve_csv(result, path):
     """spring_curve.csv: one row per load step, units in the column names."""
-    import csv
     n = len(result["stress_pa"])
     cols = [(k, c) for k, c in CURVE_COLUMNS if k in result and len(result[k]) == n]
-    tmp = path + ".part"
-    with open(tmp, "w", newline="") as f:
-        w = csv.writer(f)
-        w.writerow(["step_count"] + [c for _, c in cols])
-        for i in range(n):
-            w.writerow([i + 1] + ["" if result[k][i] is None else result[k][i] for k, _ in cols])
-    os.replace(tmp, path)
-    return path
-
-
-def _savefig(fig, path):
-    tmp = path + ".part.png"
-    fig.savefig(tmp, dpi=110)
-    os.replace(tmp, path)
+    rows = [[i + 1] + [result[k][i] for k, _ in cols] for i in range(n)]
+    return write_csv(path, ["step_count"] + [c for _, c in cols], rows)
 
 
 def write_plots(result, comparisons, out_dir):
     """spring_curve.png (force vs displacement, stress vs strain), stiffness.png (vs
     stress, with the lab band), bulk_density.png (vs stress, with the lab band)."""
-    import matplotlib
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
+    from ..plotting import new_figure, save_png
     n = len(result["stress_pa"])
     branch = result.get("branch") or ["loading"] * n
     title = f"{result['rig']} {result['material']} seed {result.get('seed')}"
@@ -285,7 +201,7 @@ def write_plots(result, comparisons, out_dir):
         for b in seen:
             yield b, [i for i in range(n) if branch[i] == b]
 
-    fig, (a1, a2) = plt.subplots(1, 2, figsize=(10, 4))
+    fig, (a1, a2) = new_figure(1, 2, figsize=(10, 4))
     for b, idx in by_branch():
         # unloading starts at the last loading point
         if b == "unloading" and idx[0] > 0:
@@ -303,13 +219,10 @@ def write_plots(result, comparisons, out_dir):
         a.legend()
     fig.suptitle(f"spring curve: {title}")
     fig.tight_layout()
-    p = os.path.join(out_dir, "spring_curve.png")
-    _savefig(fig, p)
-    plt.close(fig)
-    paths.append(p)
+    paths.append(save_png(fig, os.path.join(out_dir, "spring_curve.png")))
 
     def band_plot(fname, ylabel, key, names, logy):
-        fig, a = plt.subplots(figsize=(6, 4.2))
+        fig, a = new_figure(figsize=(6, 4.2))
         for b, idx in by_branch():
             pts = [(result["stress_pa"][i], result[key][i]) for i in idx if result[key][i] is not None]
             if pts:
@@ -333,10 +246,7 @@ def write_plots(result, comparisons, out_dir):
         a.legend(fontsize=7)
         a.set_title(title, fontsize=9)
         fig.tight_layout()
-        path = os.path.join(out_dir, fname)
-        _savefig(fig, path)
-        plt.close(fig)
-        paths.append(path)
+        paths.append(save_png(fig, os.path.join(out_dir, fname)))
 
     band_plot("stiffness.png", "stiffness d stress / d strain (Pa)", "stiffness_pa",
               [("bulk_stiffness", "C2"), ("unloading_stiffness", "C1")], True)
@@ -345,25 +255,21 @@ def write_plots(result, comparisons, out_dir):
     return paths
 
 
-def lab_sample_of(result):
-    mat = result["job"]["materials"][result["material"]] if "job" in result else {}
-    return mat.get("lab_sample")
-
-
 def write_outputs(result, out_dir=None, lab_dir=None, plots=True):
     """CSV + PNG of one compression result (dict or path to result.json) into out_dir
     (default: the folder of result.json). Returns {'files': [...], 'misfits': {...}}.
     The misfits are compact (no per-step arrays): {name: {'rms_z', 'n_points', ...}}."""
     if isinstance(result, (str, os.PathLike)):
+        from .cli import read_result
         path = str(result)
-        with open(path) as f:
-            result = json.load(f)
+        result = read_result(path)
         out_dir = out_dir or os.path.dirname(os.path.abspath(path))
     if out_dir is None:
         raise ValueError("write_outputs: out_dir is needed for a result given as a dict")
-    sample = result.get("lab_sample") or lab_sample_of(result)
+    sample = lab_sample_of(result)
     targets = load_targets(result["rig"], sample, lab_dir) if sample else {}
     comps = compare(result, targets)
+    os.makedirs(out_dir, exist_ok=True)
     files = [write_curve_csv(result, os.path.join(out_dir, "spring_curve.csv"))]
     if comps:
         files.append(write_comparison_csv(comps, os.path.join(out_dir, "lab_comparison.csv")))
@@ -373,23 +279,6 @@ def write_outputs(result, out_dir=None, lab_dir=None, plots=True):
                    "inside_band_count": c["inside_band_count"], "lab_curve": c["lab_curve"],
                    "quantity": c["quantity"]} for k, c in comps.items()}
     return {"files": files, "misfits": summary}
-
-
-def write_comparison_csv(comparisons, path):
-    """lab_comparison.csv: per misfit and lab step the lab value, band and simulated value."""
-    import csv
-    tmp = path + ".part"
-    with open(tmp, "w", newline="") as f:
-        w = csv.writer(f)
-        w.writerow(["misfit", "lab_curve", "quantity", "stress_pa", "lab_value", "lab_low", "lab_high",
-                    "sim_value", "z_ratio"])
-        for name, c in comparisons.items():
-            for i, s in enumerate(c["lab_stress_pa"]):
-                sim, z = c["sim_at_lab"][i], c["z"][i]
-                w.writerow([name, c["lab_curve"], c["quantity"], s, c["lab_value"][i], c["lab_low"][i],
-                            c["lab_high"][i], "" if sim is None else sim, "" if z is None else z])
-    os.replace(tmp, path)
-    return path
 
 
 def unloading_stiffness_log_ratio(result, min_stress_pa=10000.0, lab_dir=None):
@@ -407,22 +296,24 @@ def unloading_stiffness_log_ratio(result, min_stress_pa=10000.0, lab_dir=None):
     return sum(logs) / len(logs)
 
 
-def main(argv=None):
-    argv = sys.argv[1:] if argv is None else argv
-    if not argv:
-        print("usage: python3 -m pycal.post.compression RESULT.json [...]", file=sys.stderr)
-        return 2
-    for p in argv:
-        out = write_outputs(p)
-        print(p)
+def _cli_handle(loaded, out_dir):
+    for path, result in loaded:
+        out = write_outputs(result, out_dir or os.path.dirname(os.path.abspath(path)))
+        print(path)
         for f in out["files"]:
             print("  wrote", f)
         for k, m in out["misfits"].items():
             rms = "n/a" if m["rms_z"] is None else f"{m['rms_z']:.3g}"
             print(f"  misfit {k} vs {m['lab_curve']}:{m['quantity']}: rms_z={rms} "
                   f"({m['inside_band_count']}/{m['n_points']} steps inside the band)")
-    return 0
+
+
+def main(argv=None):
+    """python3 -m pycal.post.compression RESULT.json [...] [--out DIR]: CSV + PNG per result."""
+    from .cli import run
+    return run(argv, "pycal.post.compression", "spring curves, stiffness and lab comparison of "
+               "compression results (CSV + PNG next to each result.json)", _cli_handle)
 
 
 if __name__ == "__main__":
-    sys.exit(main())
+    raise SystemExit(main())

@@ -9,23 +9,22 @@ Several results (seeds of one job) are pooled per consolidation stress: mean and
 standard deviation of mu_static and mu_dynamic over the seeds where the cell slid, and
 the share of seeds in which it stuck.
 
-Lab comparison (labresults/curves/<rig>_<lab_sample>.csv through pycal.labdata, or
-plain arrays given to `compare`): per quantity (mu_static, mu_dynamic) the misfit of
-pycal.post.compression.misfit: RMS over the lab steps where the lab cell slides of
+Lab comparison (labresults/curves/<rig>_<lab_sample>.csv through pycal.post.lab_curves,
+or plain arrays given to `compare`): per quantity (mu_static, mu_dynamic) the misfit of
+pycal.post.lab_curves.misfit: RMS over the lab steps where the lab cell slides of
 z = (sim - lab) / (half band width on the side of sim), the simulated mean curve
 interpolated in log(stress); |z| <= 1 is inside the band. Lab steps where the cell
 sticks are compared as outcomes: `outcome_mismatch_count` counts lab steps whose
 outcome (slides / sticks) differs from the simulated majority at the nearest simulated
 stress (within 5 %; farther steps are skipped).
 """
-import csv
-import json
 import math
 import os
-import sys
 
-from . import mean_std
-from .compression import misfit, EXTRAPOLATE_RATIO
+from ..files import write_csv
+from . import lab_curves, mean_std
+from .lab_curves import (EXTRAPOLATE_RATIO, band_z, interp_log_stress, lab_sample_of,  # noqa: F401 (API)
+                         misfit, sliding_steps, targets_from_arrays, write_comparison_csv)
 
 QUANTITIES = ("mu_static", "mu_dynamic")
 # mu_dynamic = tan t - a / (g cos t) loses mu as cos t -> 0 (at 90 deg a = g whatever mu is):
@@ -81,45 +80,10 @@ def seed_summary(results):
 
 # ------------------------------------------------------------------ lab targets
 
-def lab_sample_of(result):
-    mat = result["job"]["materials"][result["material"]] if "job" in result else {}
-    return result.get("lab_sample") or mat.get("lab_sample")
-
-
 def load_targets(rig, lab_sample, lab_dir=None):
-    """{quantity: {'stress_pa', 'value', 'low', 'high', 'outcome'}} of the lab curve
-    <rig>_<lab_sample> (None where the lab cell sticks) plus '_name'; {} when there is
-    no such curve (or pycal.labdata cannot be used)."""
-    try:
-        from .. import labdata
-    except ImportError:      # pragma: no cover - labdata needs pandas
-        return {}
-    kw = {} if lab_dir is None else {"lab_dir": lab_dir}
-    name = f"{rig}_{lab_sample}"
-    if name not in labdata.curve_names(**kw):
-        return {}
-    df = labdata.load_curve(name, **kw)
-    out = {"_name": name}
-    for q in labdata.curve_quantities(df):
-        t = labdata.target_curve(name, q, **kw)
-
-        def clean(a):
-            return [None if (x is None or (isinstance(x, float) and math.isnan(x))) else float(x) for x in a]
-
-        out[q] = {"stress_pa": [float(x) for x in t.stress_pa], "value": clean(t.value), "low": clean(t.low),
-                  "high": clean(t.high), "outcome": [str(x) for x in t.outcome]}
-    return out
-
-
-def targets_from_arrays(stress_pa, value, low, high, outcome=None):
-    """One target in the form of load_targets from plain arrays (None/NaN = sticks)."""
-    def clean(a):
-        return [None if (x is None or (isinstance(x, float) and math.isnan(x))) else float(x) for x in a]
-    value = clean(value)
-    if outcome is None:
-        outcome = ["sticks" if v is None else "slides" for v in value]
-    return {"stress_pa": [float(s) for s in stress_pa], "value": value, "low": clean(low),
-            "high": clean(high), "outcome": list(outcome)}
+    """Targets (pycal.post.lab_curves form) of the lab curve <rig>_<lab_sample>
+    (value None where the lab cell sticks); {} when there is no such curve."""
+    return lab_curves.load_targets([f"{rig}_{lab_sample}"], lab_dir)
 
 
 def _nearest(stresses, s):
@@ -136,10 +100,8 @@ def compare(summary, targets):
         t = targets.get(q)
         if not t:
             continue
-        slides = [i for i, o in enumerate(t["outcome"]) if o == "slides" and t["value"][i] is not None]
-        m = misfit(summary["stress_pa"], summary[f"{q}_mean"],
-                   [t["stress_pa"][i] for i in slides], [t["value"][i] for i in slides],
-                   [t["low"][i] for i in slides], [t["high"][i] for i in slides])
+        lab_s, lab_v, lab_lo, lab_hi = sliding_steps(t)
+        m = misfit(summary["stress_pa"], summary[f"{q}_mean"], lab_s, lab_v, lab_lo, lab_hi)
         mismatch, compared = 0, 0
         for i, s in enumerate(t["stress_pa"]):
             k = _nearest(summary["stress_pa"], s)
@@ -151,9 +113,8 @@ def compare(summary, targets):
                 mismatch += 1
         m.update({"lab_curve": targets.get("_name", "arrays"), "quantity": q,
                   "outcome_mismatch_count": mismatch, "outcome_compared_count": compared,
-                  "lab_stress_pa": [t["stress_pa"][i] for i in slides],
-                  "lab_value": [t["value"][i] for i in slides], "lab_low": [t["low"][i] for i in slides],
-                  "lab_high": [t["high"][i] for i in slides], "lab_all": t})
+                  "lab_stress_pa": lab_s, "lab_value": lab_v, "lab_low": lab_lo, "lab_high": lab_hi,
+                  "lab_all": t})
         out[q] = m
     return out
 
@@ -193,12 +154,9 @@ def friction_offset(result, quantity="mu_static", min_stress_pa=10000.0, targets
     stages). Below ~10 kPa a loose bed shears inside itself first (measured), so those
     steps say little about the contact friction.
     targets: as load_targets (default: the lab curve of the rig and the material)."""
-    from .compression import interp_log_stress
     t = _lab_target(result, quantity, targets)
     sim = compared_values(result, quantity)
-    slides = [i for i, o in enumerate(t["outcome"]) if o == "slides" and t["value"][i] is not None]
-    lab_s = [t["stress_pa"][i] for i in slides]
-    lab_v = [t["value"][i] for i in slides]
+    lab_s, lab_v, _, _ = sliding_steps(t)
     diffs = []
     for k, s in enumerate(result["stress_pa"]):
         if s < min_stress_pa:
@@ -219,7 +177,6 @@ def friction_band_z(result, quantity="mu_static", min_stress_pa=10000.0, targets
     interpolated in log(stress) (None where it does not reach that step; a simulated
     step that sticks counts as STICKS_MU). |z| <= 1 is inside the band: the residual
     vector of the calibration's joint stages."""
-    from .compression import interp_log_stress, band_z
     t = _lab_target(result, quantity, targets)
     sim = compared_values(result, quantity)
     out = []
@@ -243,48 +200,27 @@ def write_summary_csv(summary, comparisons, path):
     for q in QUANTITIES:
         if q in comparisons:
             lab_cols += [f"lab_{q}", f"lab_{q}_low", f"lab_{q}_high", f"lab_{q}_outcome"]
-    tmp = path + ".part"
-    with open(tmp, "w", newline="") as f:
-        w = csv.writer(f)
-        w.writerow(cols + lab_cols)
-        for i, s in enumerate(summary["stress_pa"]):
-            row = ["" if summary[c][i] is None else summary[c][i] for c in cols]
-            for q in QUANTITIES:
-                if q not in comparisons:
-                    continue
-                t = comparisons[q]["lab_all"]
-                j = next((j for j, ls in enumerate(t["stress_pa"]) if abs(ls - s) <= 1e-6 * s), None)
-                if j is None:
-                    row += ["", "", "", ""]
-                else:
-                    row += ["" if t[k][j] is None else t[k][j] for k in ("value", "low", "high")] + [t["outcome"][j]]
-            w.writerow(row)
-    os.replace(tmp, path)
-    return path
-
-
-def write_comparison_csv(comparisons, path):
-    """lab_comparison.csv: per quantity and lab step (slides) lab value, band, sim, z."""
-    tmp = path + ".part"
-    with open(tmp, "w", newline="") as f:
-        w = csv.writer(f)
-        w.writerow(["quantity", "lab_curve", "stress_pa", "lab_value", "lab_low", "lab_high", "sim_value", "z_ratio"])
-        for q, c in comparisons.items():
-            for i, s in enumerate(c["lab_stress_pa"]):
-                sim, z = c["sim_at_lab"][i], c["z"][i]
-                w.writerow([q, c["lab_curve"], s, c["lab_value"][i], c["lab_low"][i], c["lab_high"][i],
-                            "" if sim is None else sim, "" if z is None else z])
-    os.replace(tmp, path)
-    return path
+    rows = []
+    for i, s in enumerate(summary["stress_pa"]):
+        row = [summary[c][i] for c in cols]
+        for q in QUANTITIES:
+            if q not in comparisons:
+                continue
+            t = comparisons[q]["lab_all"]
+            j = next((j for j, ls in enumerate(t["stress_pa"]) if abs(ls - s) <= 1e-6 * s), None)
+            if j is None:
+                row += [None] * 4
+            else:
+                row += [t[k][j] for k in ("value", "low", "high")] + [t["outcome"][j]]
+        rows.append(row)
+    return write_csv(path, cols + lab_cols, rows)
 
 
 def write_plot(summary, comparisons, path, title):
     """friction_vs_stress.png: mean +/- std of mu_static and mu_dynamic vs stress (kPa),
     the lab curves with their bands, sticking steps marked (x at the top)."""
-    import matplotlib
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-    fig, ax = plt.subplots(figsize=(7, 4.5))
+    from ..plotting import new_figure, save_png
+    fig, ax = new_figure(figsize=(7, 4.5))
     colours = {"mu_static": "C0", "mu_dynamic": "C3"}
     s_kpa = [s / 1e3 for s in summary["stress_pa"]]
     for q in QUANTITIES:
@@ -317,11 +253,7 @@ def write_plot(summary, comparisons, path, title):
     ax.grid(alpha=0.3)
     ax.legend(fontsize=8)
     fig.tight_layout()
-    tmp = path + ".part.png"
-    fig.savefig(tmp, dpi=110)
-    os.replace(tmp, path)
-    plt.close(fig)
-    return path
+    return save_png(fig, path)
 
 
 def write_outputs(results, out_dir, lab_dir=None, targets=None, plots=True):
@@ -329,12 +261,9 @@ def write_outputs(results, out_dir, lab_dir=None, targets=None, plots=True):
     (seeds). targets: as load_targets (default: the lab curve of the rig and the
     material's lab_sample). Returns {'files', 'summary', 'misfits'} with compact misfits
     {quantity: {'rms_z', 'n_points', 'inside_band_count', 'outcome_mismatch_count', ...}}."""
-    loaded = []
-    for r in results if isinstance(results, (list, tuple)) else [results]:
-        if isinstance(r, (str, os.PathLike)):
-            with open(r) as f:
-                r = json.load(f)
-        loaded.append(r)
+    from .cli import read_result
+    loaded = [read_result(r) if isinstance(r, (str, os.PathLike)) else r
+              for r in (results if isinstance(results, (list, tuple)) else [results])]
     rigs = {r["rig"] for r in loaded}
     if len(rigs) != 1 or not rigs <= set(RIGS):
         raise ValueError(f"write_outputs: results of one friction rig expected, got {sorted(rigs)}")
@@ -357,18 +286,13 @@ def write_outputs(results, out_dir, lab_dir=None, targets=None, plots=True):
     return {"files": files, "summary": summary, "misfits": misfits}
 
 
-def main(argv=None):
-    argv = sys.argv[1:] if argv is None else argv
-    out = None
-    if "--out" in argv:
-        i = argv.index("--out")
-        out = argv[i + 1]
-        argv = argv[:i] + argv[i + 2:]
-    if not argv:
-        print("usage: python3 -m pycal.post.friction RESULT.json [...] [--out DIR]", file=sys.stderr)
-        return 2
-    out = out or os.path.dirname(os.path.abspath(argv[0]))
-    res = write_outputs(argv, out)
+def _cli_handle(loaded, out_dir):
+    from ..errors import ConfigError
+    rigs = {r["rig"] for _, r in loaded}
+    if len(rigs) != 1 or not rigs <= set(RIGS):
+        raise ConfigError(loaded[0][0], "rig", f"results of one friction rig ({', '.join(RIGS)}) expected, "
+                                               f"got {', '.join(sorted(rigs))}")
+    res = write_outputs([r for _, r in loaded], out_dir or os.path.dirname(os.path.abspath(loaded[0][0])))
     for f in res["files"]:
         print("wrote", f)
     s = res["summary"]
@@ -383,8 +307,14 @@ def main(argv=None):
         rms = "n/a" if m["rms_z"] is None else f"{m['rms_z']:.3g}"
         print(f"misfit {q} vs {m['lab_curve']}: rms_z={rms} ({m['inside_band_count']}/{m['n_points']} inside "
               f"the band; outcome mismatches {m['outcome_mismatch_count']}/{m['outcome_compared_count']})")
-    return 0
+
+
+def main(argv=None):
+    """python3 -m pycal.post.friction RESULT.json [...] [--out DIR]: the seeds of one job pooled."""
+    from .cli import run
+    return run(argv, "pycal.post.friction", "friction vs consolidation stress of the seeds of one "
+               "friction job against the lab curve (CSV + PNG)", _cli_handle)
 
 
 if __name__ == "__main__":
-    sys.exit(main())
+    raise SystemExit(main())

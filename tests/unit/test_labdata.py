@@ -40,7 +40,7 @@ def test_shipped_data_pass():
     assert set(data["samples"]["samples"]) == {"gravel_dry", "fines_dry", "fines_wet",
                                                "sample50_dry", "sample50_wet"}
     for df in data["curves"].values():
-        assert list(df["stress_pa"]) == [3000, 6000, 12000, 24000, 40000, 60000, 86000]
+        assert list(df["stress_pa"]) == [3000, 6000, 12000, 24000, 40000, 60000, 90000]
         assert set(df["provenance"]) == {"reconstructed"}
 
 

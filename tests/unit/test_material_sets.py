@@ -25,7 +25,7 @@ def test_shipped_sets_have_the_lab_fractions_of_the_minus_50_mm_sample():
         s = load_material_set(name)
         c = s["components"]
         assert list(c) == ["M1", "M2", fines]
-        # lab-tests.md section 2, classes below 50 mm renormalised to 73.7 %
+        # docs/lab-tests.md section 2, classes below 50 mm renormalised to 73.7 %
         assert c["M1"]["mass_fraction"] == pytest.approx(3.9 / 73.7)
         assert c["M2"]["mass_fraction"] == pytest.approx((15.7 + 16.8) / 73.7)
         assert c[fines]["mass_fraction"] == pytest.approx((35.5 + 1.8) / 73.7)
@@ -41,7 +41,7 @@ def test_set_job_holds_every_component_with_agreeing_pair_values():
     for a in mats:
         for b in mats:
             assert mats[a]["interactions"][b] == mats[b]["interactions"][a], (a, b)
-    # method.md: wet fines - gravel = the fines-wall adhesion; M1 rolling 0 on every pair
+    # docs/method.md: wet fines - gravel = the fines-wall adhesion; M1 rolling 0 on every pair
     assert mats["M2"]["interactions"]["M3-wet"]["cohesion"]["force_fraction"] == 0.3
     assert mats["M1"]["interactions"]["M3-wet"]["cohesion"]["force_fraction"] == 0.3
     assert mats["M2"]["interactions"]["M1"]["rolling_resistance_coefficient"] == 0.0

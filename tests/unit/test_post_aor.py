@@ -51,11 +51,35 @@ def test_asymmetric_pile_left_and_right_differ():
 
 
 def test_flat_layer_has_no_angle():
+    """A monolayer has no flank: no sector has an angle, and none is made up (NaN, null
+    in result.json, one warning per sector), not 0 degrees."""
     xs = np.arange(-0.15, 0.15, 2 * R)
     pts = [(x, y, R, R) for x in xs for y in xs]
     m = aor.measure_pile(pts, **CFG)
-    for side, a in m["angles"].items():
-        assert a == pytest.approx(0.0, abs=0.5), side
+    assert all(math.isnan(a) for a in m["angles"].values())
+    assert math.isnan(m["mean_deg"]) and m["sectors_count"] == 0
+    keys = aor.result_keys(m)
+    assert keys["aor_mean_deg"] is None and keys["aor_left_deg"] is None and keys["aor_sectors_count"] == 0
+    assert len(aor.missing_angles(m)) == 4
+
+
+def test_a_sector_without_an_angle_is_left_out_of_the_mean():
+    """A 35 degree ridge: the cone with its front and back flanks cut down to the first
+    layer. Left and right read 35, front and back have no angle, and the mean is 35 (the
+    old rule, 0 for a missing sector, read 17.5)."""
+    pile = cone(35.0)
+    ridge = pile[~((np.abs(pile[:, 1]) >= np.abs(pile[:, 0]) - 1e-9) & (pile[:, 2] > 2 * R))]
+    m = aor.measure_pile(ridge, **CFG)
+    assert math.isnan(m["angles"]["front"]) and math.isnan(m["angles"]["back"])
+    assert m["sectors_count"] == 2
+    assert m["mean_deg"] == pytest.approx(35.0, abs=1.0)
+    assert m["mean_deg"] == pytest.approx((m["angles"]["left"] + m["angles"]["right"]) / 2)
+    keys = aor.result_keys(m)
+    assert keys["aor_front_deg"] is None and keys["aor_back_deg"] is None and keys["aor_sectors_count"] == 2
+    assert keys["aor_mean_deg"] == pytest.approx(m["mean_deg"])
+    lines = aor.missing_angles(m)
+    assert len(lines) == 2 and lines[0].startswith("warning: aor front: no angle (0 silhouette slice(s)")
+    assert "left out of aor_mean_deg" in lines[0]
 
 
 def test_vertical_column_is_90_degrees_and_one_particle_has_no_angle():
@@ -67,7 +91,7 @@ def test_vertical_column_is_90_degrees_and_one_particle_has_no_angle():
         assert a == pytest.approx(90.0, abs=0.5), side
     # one particle: no fit at all
     m = aor.measure_pile([(0.0, 0.0, R, R)], **CFG)
-    assert m["mean_deg"] == 0.0
+    assert math.isnan(m["mean_deg"]) and m["sectors_count"] == 0
 
 
 def test_first_layer_and_apex_are_excluded():
@@ -78,14 +102,29 @@ def test_first_layer_and_apex_are_excluded():
     assert {r[0] for r in rows} == {"left", "right", "front", "back"}
 
 
-def test_result_keys_and_plot(tmp_path):
-    pts = cone(35.0)
-    m = aor.measure_pile(pts, **CFG)
+def test_result_keys():
+    m = aor.measure_pile(cone(35.0), **CFG)
     keys = aor.result_keys(m, "surcharge")
     assert set(keys) == {"surcharge_left_deg", "surcharge_right_deg", "surcharge_front_deg",
-                         "surcharge_back_deg", "surcharge_mean_deg"}
-    png = aor.plot_pile(pts[:300], m, tmp_path / "p.png")
-    assert (tmp_path / "p.png").stat().st_size > 1000 and png
+                         "surcharge_back_deg", "surcharge_mean_deg", "surcharge_sectors_count"}
+    assert keys["surcharge_sectors_count"] == 4 and aor.missing_angles(m) == []
+
+
+def test_side_view_draws_the_flanks_at_their_angles(tmp_path):
+    """The left and right lines of the side view rise at the cone's 35 degrees (as drawn,
+    in data coordinates), and the PNG is the stated 8 x 4 inch figure at 110 dpi."""
+    pts = cone(35.0)
+    m = aor.measure_pile(pts, **CFG)
+    fig = aor.pile_figure(pts, m)
+    lines = {l.get_label().split()[0]: l for l in fig.axes[0].lines if l.get_label().startswith(("left", "right"))}
+    assert set(lines) == {"left", "right"}
+    for side, line in lines.items():
+        x, z = line.get_data()
+        assert math.degrees(math.atan(abs((z[1] - z[0]) / (x[1] - x[0])))) == pytest.approx(35.0, abs=1.0), side
+    path = aor.plot_pile(pts, m, tmp_path / "p.png")
+    import matplotlib.image
+    assert matplotlib.image.imread(path).shape[:2] == (440, 880)
+    assert [p.name for p in tmp_path.iterdir()] == ["p.png"]       # no .part left
 
 
 def test_particles_rolled_away_on_the_table_do_not_change_the_angle():

@@ -7,6 +7,7 @@ import math
 import pytest
 
 from pycal.post import compression as c
+from pycal.post.lab_curves import targets_from_arrays
 
 
 def test_secant_stiffness_from_zero_and_between_steps():
@@ -95,8 +96,9 @@ def test_misfit_rms_over_the_lab_steps():
 def test_compare_against_plain_target_arrays():
     r = _result()
     targets = {"_name": "ccs_x", "_particle_density": 2750.0,
-               "bulk_stiffness_pa": ([3000.0, 86000.0], [1e5, 1e6], [5e4, 5e5], [2e5, 2e6]),
-               "solid_fraction": ([3000.0, 86000.0], [0.36, 0.385], [0.33, 0.355], [0.39, 0.415])}
+               "bulk_stiffness_pa": targets_from_arrays([3000.0, 86000.0], [1e5, 1e6], [5e4, 5e5], [2e5, 2e6]),
+               "solid_fraction": targets_from_arrays([3000.0, 86000.0], [0.36, 0.385], [0.33, 0.355],
+                                                     [0.39, 0.415])}
     comps = c.compare(r, targets)
     assert set(comps) == {"bulk_stiffness", "solid_fraction", "bulk_density"}
     assert comps["solid_fraction"]["rms_z"] == pytest.approx(0.0)

@@ -6,9 +6,9 @@ folder; the assertions read its result.json. Short scenes: two load steps (5 and
 
 Bounds, from measurements of this short scene with M2 start values (seeds 1-4; the
 test runs seed 1, and -j1 runs are bit-reproducible):
-- force balance (plate + weight = bottom + wall) at rest: measured |error| <= 7e-4
-  -> bound 3 %;
-- E 1e7 -> 4e7 (x4; measured first on the linear law at 3e6 -> 12e6). A Hertz contact's
+- force balance at rest (Newton: plate + weight = bottom + wall friction): measured
+  |error| <= 7e-4 (CCS, CCS expansion, seeds 1-4, first law), 3.3e-4 here, UCS 2.5e-4 -> bound 2e-3;
+- E 1e7 -> 4e7 (x4; first measured on the first law at 3e6 -> 12e6). A Hertz contact's
   stiffness at a given force scales with E^(2/3) (x2.5; a linear law's with E, x4), but (a) contacts at the Coulomb and rolling limits slip,
   and that compliance does not depend on E, and (b) the time step scales with
   1/sqrt(E), so one seed gives a different pour, hence a different packing, for each
@@ -19,10 +19,15 @@ test runs seed 1, and -j1 runs are bit-reproducible):
   loading ratio > 1.1;
 - unloading stiffer than loading: measured ratio 1.30 - 4.69 on the first unloading
   step (both E, seeds 1-4) -> bound > 1;
+- loading compacts the bulk: the bulk density rises from the fill's with every load
+  step, and 25 mm spheres in a 145 mm cell stay below random close packing of equal
+  spheres (solid fraction 0.64, a property of sphere packings, not of this code;
+  measured here 0.35 - 0.39: the wall of a 145 mm cell keeps 25 mm spheres loose);
 - a plate pushed with an absurd stress (5 MPa on 6 MPa spheres) must stop the run as
   a blow-up (overlap guard) with no result.json.
 """
-import shutil
+
+import math
 
 import pytest
 
@@ -30,8 +35,9 @@ from pycal.errors import RunError
 from pycal.jobs import resolve_job
 from pycal.runner import run_job, job_dir
 
-pytestmark = [pytest.mark.yade,
-              pytest.mark.skipif(shutil.which("yade") is None, reason="yade is not installed")]
+from documented import assert_documented
+
+pytestmark = pytest.mark.yade
 
 MATERIAL = "M2"
 SEED = 1
@@ -39,7 +45,8 @@ SHORT = {"rig.procedure.load_steps_pa": [5000, 20000],
          "rig.procedure.pour_height_factor": 2.0}
 EXPANSION = dict(SHORT, **{"rig.procedure.unload_steps_pa": [10000]})
 E_SOFT, E_STIFF = 1.0e7, 4.0e7
-BALANCE_MAX = 0.03
+BALANCE_MAX = 2.0e-3
+RANDOM_CLOSE_PACKING = 0.64
 UNLOAD_RATIO_BOUNDS = (1.3, 4.4)
 LOAD_RATIO_MIN = 1.1
 
@@ -83,28 +90,24 @@ def test_ccs_result_has_the_per_step_arrays_and_files(ccs):
                 "plate_position_m", "bottom_force_n", "wall_force_n", "force_balance_error", "solid_fraction"):
         assert len(ccs[key]) == n, key
     for target, s in zip(SHORT["rig.procedure.load_steps_pa"], ccs["stress_pa"]):
-        assert abs(s - target) <= 0.02 * target
-    # strain grows with stress; stress = plate force / cell cross-section
-    assert 0 < ccs["strain"][0] < ccs["strain"][1] < 0.5
-    for s, f in zip(ccs["stress_pa"], ccs["plate_force_n"]):
-        assert s == pytest.approx(f / ccs["reference_area_m2"])
+        assert abs(s - target) <= 0.02 * target                 # the servo reaches each step
+    assert 0 < ccs["strain"][0] < ccs["strain"][1] < 0.5        # strain grows with stress
+    assert ccs["reference_area_m2"] == pytest.approx(math.pi * 0.145 ** 2 / 4)   # the cell's cross-section
     assert ccs["n_particles"] > 40
-    assert ccs["particle_weight_n"] == pytest.approx(ccs["particle_mass_kg"] * 9.81)
     folder = job_dir(ccs["job"], runs_dir_of(ccs))
     for f in ("spring_curve.csv", "spring_curve.png", "stiffness.png", "bulk_density.png", "lab_comparison.csv"):
         assert (folder / f).is_file(), f
     header = (folder / "spring_curve.csv").read_text().splitlines()[0]
     assert "stress_pa" in header and "strain_ratio" in header and "stiffness_pa" in header
     assert "bulk_stiffness" in ccs["misfits"]
+    assert_documented(ccs)
 
 
 def test_force_balance_at_every_step(soft, stiff, ccs):
+    """At rest the bulk is in equilibrium: plate + weight = bottom + wall friction."""
     for r in (soft, stiff, ccs):
         for k, e in enumerate(r["force_balance_error"]):
             assert abs(e) < BALANCE_MAX, (r["job_id"], k, e)
-            # the same from the raw forces: plate + weight = bottom + wall friction
-            load = r["plate_force_n"][k] + r["particle_weight_n"]
-            assert r["bottom_force_n"][k] + r["wall_force_n"][k] == pytest.approx(load, rel=BALANCE_MAX)
 
 
 def test_bulk_stiffness_grows_with_youngs_modulus(soft, stiff):
@@ -118,6 +121,7 @@ def test_bulk_stiffness_grows_with_youngs_modulus(soft, stiff):
 
 
 def test_unloading_is_stiffer_than_loading(soft, stiff):
+    assert_documented(soft)
     for r in (soft, stiff):
         assert r["branch"] == ["loading", "loading", "unloading"]
         assert r["unloading_stiffness_pa"][0] > loading_last(r), r["job_id"]
@@ -125,13 +129,14 @@ def test_unloading_is_stiffer_than_loading(soft, stiff):
         assert r["strain"][0] < r["strain"][2] < r["strain"][1]
 
 
-def test_bulk_density_never_exceeds_particle_density(soft, stiff, ccs):
+def test_loading_compacts_the_bulk_below_random_close_packing(soft, stiff, ccs):
+    """Every load step packs the bulk denser than the step before (and than the fill),
+    and equal spheres do not pack beyond random close packing (0.64) without
+    overlapping far more than the contact law allows."""
     for r in (soft, stiff, ccs):
-        rho_p = r["particle_density_kg_m3"]
-        for rho, sf in zip(r["bulk_density_kg_m3"], r["solid_fraction"]):
-            assert 0 < rho < rho_p
-            assert sf == pytest.approx(rho / rho_p)
-            assert sf < 0.7405   # densest sphere packing
+        loading = [rho for rho, b in zip(r["bulk_density_kg_m3"], r["branch"]) if b == "loading"]
+        assert r["initial_bulk_density_kg_m3"] < loading[0] < loading[1], r["job_id"]
+        assert max(r["solid_fraction"]) < RANDOM_CLOSE_PACKING, r["job_id"]
 
 
 def test_plate_pushed_through_the_particles_is_a_blowup(tmp_path):
@@ -155,12 +160,11 @@ def test_ucs_pile_under_the_plate(tmp_path_factory):
     assert r["wall_force_n"] == [0.0, 0.0]                  # no wall: the table carries everything
     for k in range(2):
         assert abs(r["force_balance_error"][k]) < BALANCE_MAX
-        assert r["stress_pa"][k] == pytest.approx(r["plate_force_n"][k] / r["reference_area_m2"])
-        assert 0 < r["bulk_density_kg_m3"][k] < r["particle_density_kg_m3"]
-    assert r["reference_area_m2"] == pytest.approx(3.14159265 * 0.145 ** 2 / 4)
+    assert r["reference_area_m2"] == pytest.approx(math.pi * 0.145 ** 2 / 4)   # plate of the cell's diameter
     assert 0 < r["strain"][0] < r["strain"][1] < 0.5
     assert r["initial_height_m"] < 0.095 + 0.0125           # a pile, lower than the filled cell's top
     assert r["load_stopped_at_pa"] is None and r["load_steps_completed_count"] == 2
+    assert_documented(r)
 
 
 def test_ucs_loading_stops_at_the_overlap_limit_with_the_steps_reached(tmp_path_factory):

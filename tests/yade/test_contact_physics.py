@@ -11,6 +11,8 @@ from pycal.jobs import resolve_job
 from pycal.runner import run_job, job_dir
 from scene_runner import run_scene, scene_job
 
+from documented import assert_documented
+
 pytestmark = pytest.mark.yade
 G = 9.81
 OLD = {"rig.numerics.contact_model": "linear_cundall"}
@@ -37,6 +39,16 @@ def test_fill_mass_is_count_times_particle_mass(fill_pair):
     geo = job["rig_config"]["geometry"]
     vol = math.pi * geo["cell_inner_diameter_m"] ** 2 / 4 * geo["cell_height_m"]
     assert res["bulk_density_kg_m3"] == pytest.approx(res["mass_kg"] / vol, rel=1e-9)
+    assert_documented(res)
+
+
+def test_time_step_is_the_one_estimated_before_the_run(fill_pair):
+    """YADE's time step (0.3 x PWaveTimeStep) is what pycal.step_estimate computed from the
+    job alone: 0.3 x 0.0125 m / sqrt(6e6 Pa / 2750 kg/m3) = 8.028e-5 s."""
+    from pycal.step_estimate import critical_timestep
+    job, res, _ = fill_pair
+    assert res["timestep_s"] == pytest.approx(critical_timestep(job)[0], rel=1e-9)
+    assert res["timestep_s"] == pytest.approx(8.028e-5, rel=1e-3)
 
 
 def test_fill_is_bit_reproducible(fill_pair):

@@ -37,7 +37,6 @@ E 2e7 Pa, tilt 2 deg/s, onset 1 mm, travel 10 mm; the first law's figures in bra
 """
 import json
 import os
-import shutil
 import subprocess
 import textwrap
 from pathlib import Path
@@ -48,8 +47,9 @@ from pycal import REPO_ROOT
 from pycal.jobs import resolve_job
 from pycal.runner import run_job, yade_env
 
-pytestmark = [pytest.mark.yade,
-              pytest.mark.skipif(shutil.which("yade") is None, reason="yade is not installed")]
+from documented import assert_documented
+
+pytestmark = pytest.mark.yade
 
 SEED = 1
 NO_ROLL = {"interactions.M2.rolling_resistance_coefficient": 1.0,
@@ -117,6 +117,7 @@ def test_hysteretic_cohesion_friction_rises_with_consolidation(tmp_path_factory)
     r = wall(tmp_path_factory, "hyst", 0.2, CASES[0.2][0], cohesion=HYSTERETIC)
     assert r["mu_static"][1] - r["mu_static"][0] >= 0.05
     assert r["mu_static"][1] - base["mu_static"][1] >= 0.05
+    assert_documented(r)              # with cohesion_update_count
 
 
 # ---------------------------------------------------------------- two spheres
@@ -248,6 +249,7 @@ def test_internal_friction_fresh_fill_per_step_repeats_bit_for_bit(tmp_path_fact
     stress are the same simulation."""
     r = internal(tmp_path_factory, "internal_start", {}, [3000, 3000])
     assert r["fill_each_step"] == "fresh"
+    assert_documented(r)
     assert r["mu_static"][0] == r["mu_static"][1]
     assert r["onset_angle_deg"][0] == r["onset_angle_deg"][1]
 

@@ -3,22 +3,23 @@
 Each job goes through pycal.jobs.resolve_job + pycal.runner.run_job into a pytest tmp
 folder and the assertions read its result.json.
 """
-import shutil
 
 import pytest
 
 from pycal.jobs import resolve_job
 from pycal.runner import run_job
 
-pytestmark = [pytest.mark.yade,
-              pytest.mark.skipif(shutil.which("yade") is None, reason="yade is not installed")]
+from documented import assert_documented
+
+pytestmark = pytest.mark.yade
 
 MATERIAL = "M2"
 SEED = 3
 FAST = {"rig.procedure.lift_speed_m_s": 0.05,      # 25 x the lab speed: a ~2 s lift
         "rig.procedure.pour_height_factor": 1.6}   # just enough pour to fill to the rim
 # Bounds from measurements (seed 3, this fast scene, 64 particles):
-# - frictionless spheres spread into a flat monolayer: measured 0.0 deg -> bound 5 deg;
+# - frictionless spheres spread into a flat monolayer: no sector had an angle (the old
+#   rule read that as 0.0 deg) -> no angle, or below 5 deg, and at most two layers high;
 # - rolling 0.35 vs 0.02 (exactly 0 cannot come to rest, see the test): measured mean
 #   25.7 vs 6.2 deg (left 34 vs 7, right 24 vs 14) -> margin 10 deg.
 FRICTIONLESS_MAX_DEG = 5.0
@@ -50,8 +51,12 @@ def test_frictionless_spheres_do_not_stand(tmp_path_factory):
     over["interactions.steel.friction_coefficient"] = 0.05
     over["interactions.steel.rolling_resistance_coefficient"] = 0.05
     res = run(tmp_path_factory, "frictionless", over)
-    print("frictionless aor_mean_deg", res["aor_mean_deg"], "steps", res["steps"])
-    assert res["aor_mean_deg"] < FRICTIONLESS_MAX_DEG, res["aor_mean_deg"]
+    print("frictionless aor_mean_deg", res["aor_mean_deg"], "sectors", res["aor_sectors_count"],
+          "pile height", res["pile_height_m"], "steps", res["steps"])
+    # a monolayer has no flank to measure: no sector has an angle (null, not 0), or a
+    # stray one is low; and the pile is no higher than one layer plus a particle on it
+    assert res["aor_mean_deg"] is None or res["aor_mean_deg"] < FRICTIONLESS_MAX_DEG, res["aor_mean_deg"]
+    assert res["pile_height_m"] < 2 * 0.025
 
 
 def test_angle_rises_with_rolling_resistance(tmp_path_factory, base):
@@ -69,3 +74,4 @@ def test_same_seed_is_bit_identical(tmp_path_factory, base):
     assert again["provenance"]["started_utc"] and again["job_id"] == base["job_id"]
     for k in ANGLES + ("steps", "n_particles", "pile_height_m"):
         assert again[k] == base[k], k
+    assert_documented(base)

@@ -9,7 +9,6 @@ seed spread of the bulk density ~4.4 %, standard error with 2 seeds ~3 %); the
 recovered density can only be as good as that: within 5 % of the truth, while the
 start value is 24 % off.
 """
-import shutil
 
 import pytest
 
@@ -18,8 +17,7 @@ from pycal.jobs import resolve_job
 from pycal.post import mean_std
 from pycal.runner import LocalPool
 
-pytestmark = [pytest.mark.yade,
-              pytest.mark.skipif(shutil.which("yade") is None, reason="YADE not installed")]
+pytestmark = pytest.mark.yade
 
 TRUTH_KG_M3 = 3600.0
 

@@ -1,7 +1,7 @@
-"""Non-round M1 lumps as YADE clumps of spheres (lab-tests.md section 7).
+"""Non-round M1 lumps as YADE clumps of spheres (docs/lab-tests.md section 7).
 
 Geometry rule ("rounded box of spheres"), one rule for every shape:
-- A shape has a vertical aspect ratio v and a horizontal aspect ratio h (lab-tests.md
+- A shape has a vertical aspect ratio v and a horizontal aspect ratio h (docs/lab-tests.md
   section 7). In the lump's own frame its bounding box is (x, y, z) = (1, h, v) x L:
   x = the reference length, y = the horizontal width, z = the vertical height.
   oblong (1.7 / 0.7): 1 x 0.7 x 1.7; rounded (1.0 / 1.0): a cube; slab (0.5 / 1.0):

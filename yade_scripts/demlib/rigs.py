@@ -149,17 +149,36 @@ def vibrate_table(scene, table_ids, frequency, amp_x, amp_z, duration, updates_p
 
 def measure_pile(scene, out_dir, prefix="aor", files="pile", title=None):
     """Measure the pile (pycal.post.aor; the repo root is on PYTHONPATH),
-    write <files>_particles.csv, <files>_profile.csv and <files>_side.png.
+    write <files>_particles.csv, <files>_profile.csv and <files>_side.png; print one
+    warning line per sector without an angle (null in result.json, left out of the mean).
     Returns (result keys {prefix_left_deg, ...}, full measurement dict)."""
     import os
     from pycal.post import aor as aor_post
     positions = scene.particle_positions()
     write_csv(out_dir, f"{files}_particles.csv", ["x_m", "y_m", "z_m", "radius_m"], positions)
     m = aor_post.measure_from_config(positions, scene.rig["measure"])
-    write_csv(out_dir, f"{files}_profile.csv", ["sector", "r_edge_m", "z_m", "used_in_fit"],
-              aor_post.profile_rows(m))
-    try:
-        aor_post.plot_pile(positions, m, os.path.join(out_dir, f"{files}_side.png"), title=title)
-    except Exception as exc:  # a figure must not cost the run
-        print(f"warning: {files}_side.png not drawn: {exc}", flush=True)
+    write_csv(out_dir, f"{files}_profile.csv", aor_post.PROFILE_COLUMNS, aor_post.profile_rows(m))
+    aor_post.plot_pile(positions, m, os.path.join(out_dir, f"{files}_side.png"), title=title)
+    for line in aor_post.missing_angles(m, prefix):
+        print(line, flush=True)
     return aor_post.result_keys(m, prefix), m
+
+
+def cylinder_lift_pile(scene, fill=fill_cell):
+    """The cylinder-lift pile of the AoR rigs: fill(scene) (default fill_cell: pour,
+    settle, strike), lift the cylinder at procedure.lift_speed_m_s until it is
+    lift_clearance_m above the highest particle top, erase it, settle the pile.
+    Returns (the timing and count entries of result.json, the fill's dict)."""
+    p = scene.rig["procedure"]
+    cell = fill(scene)
+    lift = lift_cylinder(scene, cell["cylinder_ids"], p["lift_speed_m_s"], p["lift_clearance_m"])
+    t_settle, n_fallen = settle_pile(scene, "pile settle")
+    return {
+        "lift_time_s": lift["lift_time_s"],
+        "lift_height_m": lift["lift_height_m"],
+        "settle_time_s": t_settle,
+        "fill_settle_time_s": cell["settle_time_s"],
+        "n_fallen_off": lift["n_fallen"] + n_fallen,
+        "steps": O.iter,
+        "timestep_s": cell["timestep_s"],
+    }, cell
