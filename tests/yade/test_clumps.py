@@ -133,7 +133,8 @@ cid = list(sc.clumps)[0]
 sc.set_timestep()
 st = O.bodies[cid].state
 st.vel = (0.1, 0, 0)                        # lands sliding
-t_rest = sc.settle("slab")
+from yade_scripts.demlib.phases import drive
+t_rest = drive(sc.settle("slab"))
 pos0 = np.array(st.pos)
 sc.advance(int(1.0 / O.dt))                 # one more second at rest
 pos1 = np.array(st.pos)

@@ -20,7 +20,8 @@ _STARTED = datetime.datetime.now(datetime.timezone.utc).isoformat(timespec="seco
 
 
 from pycal.contact_rules import law_of_job
-from pycal.rig_contract import RESULT_FILE, RIG_FAILURE_FILE, EXIT_RIG_FAILURE, EXIT_ERROR, EXIT_OK
+from pycal.rig_contract import (RESULT_FILE, RIG_FAILURE_FILE, EXIT_RIG_FAILURE, EXIT_ERROR, EXIT_OK,
+                                BATCH_SEEDS_KEY)
 
 
 class RigFailure(Exception):
@@ -117,10 +118,12 @@ def write_csv(out_dir, name, columns, rows):
 
 
 def write_result(out_dir, job, measurements):
-    """result.json = measurements + the contact law that made them + job + provenance. Call once, last."""
+    """result.json = measurements + the contact law that made them + job + provenance. Call once, last.
+    A batch job (seeds, demlib.replicas): `seeds` instead of `seed`, the measurements hold `replicas`."""
     result = dict(measurements)
-    result.update({"job_id": job.get("job_id"), "rig": job["rig"], "material": job["material"],
-                   "seed": job["seed"], "contact_model": law_of_job(job), "job": job, "provenance": provenance()})
+    seed = {BATCH_SEEDS_KEY: job[BATCH_SEEDS_KEY]} if BATCH_SEEDS_KEY in job else {"seed": job["seed"]}
+    result.update({"job_id": job.get("job_id"), "rig": job["rig"], "material": job["material"], **seed,
+                   "contact_model": law_of_job(job), "job": job, "provenance": provenance()})
     text = json.dumps(result, indent=1, sort_keys=True, allow_nan=False)
     _atomic_write(os.path.join(out_dir, RESULT_FILE), text)
     print("RESULT written:", os.path.join(out_dir, RESULT_FILE), flush=True)

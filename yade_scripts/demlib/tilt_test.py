@@ -22,6 +22,7 @@ from yade import O
 from yade import Vector3
 
 from .jobio import RigFailure
+from .phases import drive
 from .tilt_bodies import force_sum, join, set_damped, split, stop_all
 from pycal.post.friction import DYNAMIC_MAX_ANGLE_DEG  # pure Python: one rule for rig and post
 
@@ -106,7 +107,7 @@ def free_the_cell(scene, cell, lid, proc, step_index):
     # freed at zero tilt, the cell can drift while the unloaded contents relax (wet fines
     # after 60 kPa: 4.3 mm before 0.5 deg of tilt, measured); that is not sliding
     x_free, y_free = cell.pos[0], cell.pos[1]
-    scene.settle(f"cell freed before the tilt of step {step_index}")
+    drive(scene.settle(f"cell freed before the tilt of step {step_index}"))
     return math.hypot(cell.pos[0] - x_free, cell.pos[1] - y_free)
 
 
@@ -216,7 +217,7 @@ def tilt_back(run, scene, cell, lid, proc):
         run.tilt.set(max(0.0, run.tilt.angle_deg - back * run.dt_chunk))
         run.chunk()
     run.spilled += remove_spilled(scene, run.spill_box)
-    scene.settle(f"tilt back after step {run.step_index}")
+    drive(scene.settle(f"tilt back after step {run.step_index}"))
 
 
 def tilt_test(scene, tilt, cell, lid, plate_ids, spill_box, proc, record, step_index, restore=True):
