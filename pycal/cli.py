@@ -35,13 +35,14 @@ def _make_jobs(args):
 
 def _cmd_run(args):
     from .runner import make_executor
+    from .replicas import ReplicaExecutor, result_folder
     jobs = _make_jobs(args)
-    ex = make_executor(args.executor, runs_dir=args.out, workers=args.workers,
-                       timeout_s=args.timeout_s)
+    ex = ReplicaExecutor(make_executor(args.executor, runs_dir=args.out, workers=args.workers,
+                                       timeout_s=args.timeout_s), args.replicas, args.replica_layout)
     results = ex.run(jobs)
     from . import post
     for job, res in zip(jobs, results):
-        print(f"{job['job_id']}: {args.out}/{job['rig']}/{job['job_id']}")
+        print(f"{res.get('job_id', job['job_id'])}: {result_folder(res, job, args.out)}")
         print("  " + post.summary_line(res))
     if len(results) > 1:
         print(post.seed_statistics_text(results))
@@ -98,6 +99,12 @@ def build_parser():
     s.add_argument("--workers", type=int, default=None, help="parallel YADE processes (default: cores)")
     s.add_argument("--executor", default="local", choices=["local", "yade-batch"])
     s.add_argument("--timeout-s", type=float, default=3600.0, help="timeout per job in seconds")
+    s.add_argument("--replicas", type=int, default=None, metavar="N",
+                   help="seeds per YADE run (a batch job, pycal.replicas); 1: one seed per run. Default: "
+                        "the seeds spread over the workers, for the rigs where it pays")
+    s.add_argument("--replica-layout", default="sequential", choices=["sequential", "side_by_side"],
+                   help="a batch's seeds one after the other in one YADE process (default: the same "
+                        "numbers as single runs) or side by side in one scene")
     s.set_defaults(func=_cmd_run)
 
     s = sub.add_parser("job", help="print the resolved job file (no run)")

@@ -151,6 +151,6 @@ def test_cli_bad_override_exit_2(tmp_path, capsys):
 
 
 def test_cli_run_with_fake_yade(tmp_path, fake_yade, capsys):
-    rc = main(["run", "fill", "--material", "M2", "--seeds", "2", "--out", str(tmp_path / "runs")])
+    rc = main(["run", "fill", "--material", "M2", "--seeds", "2", "--replicas", "1", "--out", str(tmp_path / "runs")])
     out = capsys.readouterr().out
     assert rc == 0 and "bulk_density_kg_m3=1600" in out and "over 2 seeds" in out
