@@ -33,7 +33,6 @@ sys.path.insert(0, str(ROOT))
 from pycal.gitinfo import git_commit  # noqa: E402
 from pycal.jobs import parse_set, resolve_job  # noqa: E402
 from pycal.runner import run_job  # noqa: E402
-from pycal import replicas  # noqa: E402
 
 OUT = Path(__file__).resolve().parent / "seed_cost.jsonl"
 DEFAULT_KEYS = {"fill": "bulk_density_kg_m3,n_particles", "aor": "aor_mean_deg,n_particles,lift_time_s",
@@ -80,6 +79,7 @@ def run_mode(rig, material, overrides, seeds, mode, size, layout="side_by_side")
             per_seed[s], cpu, wall = res, cpu + c, wall + w
             print(f"  lone seed {s}: {c:.1f} s CPU, {w:.1f} s wall", flush=True)
     else:
+        from pycal import replicas
         for part in replicas.split(seeds, size):
             job = replicas.resolve_batch(rig, material, overrides, part, layout)
             res, c, w = timed(job)
@@ -146,7 +146,7 @@ def main(argv=None):
     p.add_argument("--set", action="append", metavar="KEY=VALUE")
     p.add_argument("--mode", choices=["lone", "batch", "both"], default="both")
     p.add_argument("--replicas", type=int, default=None, help="seeds per batch (default: all seeds in one)")
-    p.add_argument("--layout", choices=list(replicas.LAYOUTS), default="side_by_side",
+    p.add_argument("--layout", choices=["sequential", "side_by_side"], default="sequential",
                    help="replica layout of the batch mode")
     p.add_argument("--keys", default=None, help="result keys to tabulate (comma separated)")
     p.add_argument("--label", default="", help="free text stored with the line (what is being compared)")
