@@ -135,10 +135,6 @@ class Scene:
         o = self.origin
         return Vector3(o[0] + x, o[1] + y, o[2] + z)
 
-    def local(self, pos):
-        """A world position relative to the scene's origin (m)."""
-        return pos - self.origin
-
     def add_cylinder(self, diameter, height, segments, material, z0=0.0):
         """Side wall of a cylinder (facets), axis z through the origin, bottom edge at z0.
         Returns facet ids."""
