@@ -1,12 +1,15 @@
 """Profile one rig job inside YADE: per-engine times (O.timingEnabled), time spent in the
-O.step() loops against the Python work between them, per phase.
+O.step() loops against the Python work between them (rest checks, guards, servo, records,
+measurement and outputs).
 
     yade -j1 -x -n bench/profile_rig.py job.json [out.json]
 
 (the repo root on PYTHONPATH, as pycal.runner.yade_env() sets it; `bench/profile.py`
 makes the job and runs this). Writes out.json (default profile.json next to the job):
-{'wall_s', 'cpu_s', 'steps', 'engines': {label: s}, 'step_loop_s', 'python_between_s',
-'result': the rig's measurements}.
+{'wall_s', 'cpu_s', 'steps', 'engines_s': {label: s}, 'engine_shares': {label: fraction},
+'step_loop_s', 'step_loop_cpu_s', 'python_between_s', 'python_between_cpu_s', 'result': the
+rig's measurements}. The engines' execTime is wall-clock time: on a loaded machine read
+their shares, and the CPU times (time.process_time) for the split loop / Python.
 """
 import json
 import os
@@ -30,13 +33,15 @@ def main():
     import importlib
     mod = importlib.import_module("yade_scripts." + script[:-3])
     rig_main = _captured[-1] if _captured else mod.main
-    loop = {"s": 0.0, "steps": 0, "calls": 0}
+    loop = {"s": 0.0, "cpu_s": 0.0, "steps": 0}
     real_step = O.step
+    clock, cpu_clock = time.perf_counter, time.process_time
 
     def timed_step():
-        t = time.perf_counter()
+        t, c = clock(), cpu_clock()
         real_step()
-        loop["s"] += time.perf_counter() - t
+        loop["s"] += clock() - t
+        loop["cpu_s"] += cpu_clock() - c
         loop["steps"] += 1
 
     # every stepping loop of the rigs goes through O.step (Scene.advance, the servo, the tilt):
@@ -63,8 +68,11 @@ def main():
     for e in O.engines:
         name = e.label or type(e).__name__
         engines[name] = engines.get(name, 0.0) + e.execTime * 1e-9
+    total = sum(engines.values()) or 1.0
     prof = {"wall_s": wall, "cpu_s": cpu, "steps": O.iter, "engines_s": engines,
+            "engine_shares": {k: v / total for k, v in engines.items()},
             "step_loop_s": loop["s"], "python_between_s": wall - loop["s"],
+            "step_loop_cpu_s": loop["cpu_s"], "python_between_cpu_s": cpu - loop["cpu_s"],
             "engines_total_s": sum(engines.values()),
             "result": {k: v for k, v in (result or {}).items() if k != "job"}}
     with open(out_path, "w") as f:
