@@ -33,7 +33,7 @@ def fake_yade(tmp_path, monkeypatch):
     exe = tmp_path / "fake-yade"
     exe.write_text(FAKE_YADE)
     exe.chmod(exe.stat().st_mode | stat.S_IEXEC)
-    monkeypatch.setattr(runner, "YADE", str(exe))
+    monkeypatch.setenv("PYCAL_YADE", str(exe))
     count = tmp_path / "count"
     count.write_text("")
     monkeypatch.setenv("FAKE_COUNT", str(count))
@@ -131,7 +131,8 @@ def test_batch_table(tmp_path):
     table = tmp_path / "t.table"
     runner.write_batch_table(table, [("a", tmp_path / "a.json"), ("b", tmp_path / "b.json")])
     lines = table.read_text().splitlines()
-    assert lines[0] == "description jobFile" and lines[1].startswith("a /")
+    # yade-batch evaluates each value as Python: the path is a quoted absolute path
+    assert lines[0] == "description jobFile" and lines[1] == f"a '{tmp_path / 'a.json'}'"
 
 
 def test_cli_bad_material_one_line_exit_2(tmp_path, capsys):
