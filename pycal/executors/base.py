@@ -67,8 +67,7 @@ class Executor:
                 errors.append(refused)
             else:
                 todo.append(i)
-        if todo:
-            clean_stale_temporaries(self.runs_dir, [jobs[i]["rig"] for i in todo])
+        clean_stale_temporaries(self.runs_dir, [job["rig"] for job in jobs])
         self.simulated_count += len(todo)
         if self.progress and todo:
             say(f"running {len(todo)} job(s) ({len(first) - len(todo)} cached) on {self.where()}")

@@ -133,14 +133,19 @@ def log_tail(log_path, n=3):
 
 
 def pid_alive(pid):
-    """True when a process with this pid exists on this host (a reused pid counts as alive)."""
+    """True when a process with this pid runs on this host (a reused pid counts as alive,
+    a zombie, dead but not reaped yet, does not)."""
     try:
         os.kill(pid, 0)
     except ProcessLookupError:
         return False
     except PermissionError:
-        return True
-    return True
+        pass
+    try:
+        stat = Path(f"/proc/{pid}/stat").read_text()
+    except OSError:
+        return True                     # no /proc: trust the signal test
+    return stat.rsplit(")", 1)[-1].split()[0] != "Z"
 
 
 def _newest_change(path):

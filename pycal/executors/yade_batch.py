@@ -126,6 +126,7 @@ class YadeBatch(Executor):
     """Runs jobs through yade-batch tables (same scripts, same job files, same results)."""
 
     name = "yade-batch"
+    patience_margin_s = 120.0     # beyond the lines' own timeouts, before a silent yade-batch is stopped
 
     def where(self):
         return f"yade-batch -j {self.workers}"
@@ -161,7 +162,7 @@ class YadeBatch(Executor):
         cmd = batch_command(table, SCRIPT_DIR / script, self.workers, log_format, executable)
         env = dict(yade_env(), PYTHONUNBUFFERED="1")
         waves = math.ceil(len(ks) / self.workers)
-        patience_s = self.timeout_s * waves + 120.0      # no line can take longer than its timeout
+        patience_s = self.timeout_s * waves + self.patience_margin_s     # no line outlives its timeout
         output, lines = [], queue.Queue()
         try:
             proc = subprocess.Popen(die_with_parent(cmd), cwd=runs / rig, env=env, stdin=subprocess.DEVNULL,
