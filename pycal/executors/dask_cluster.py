@@ -87,6 +87,7 @@ class DaskExecutor(Executor):
         self.scheduler = scheduler_address(scheduler) if scheduler else None
         self.connect_timeout_s, self.reconnect_s, self.heartbeat_s = connect_timeout_s, reconnect_s, heartbeat_s
         self._client, self._cluster, self._announced = None, None, False
+        self.reconnect_count = 0          # times the scheduler went away and came back
         _distributed()
         if self.scheduler:
             self._client = self._connect(self.scheduler, connect_timeout_s)
@@ -232,6 +233,7 @@ class DaskExecutor(Executor):
                                f"{self.reconnect_s:.0f} s; {n_left} job(s) not run, complete jobs are kept in "
                                f"{runs}: run the same command again to resume")
         self._client = client
+        self.reconnect_count += 1
         if self.progress:
             say(f"the Dask scheduler {self.scheduler} is back ({self._worker_count()} worker(s)): "
                 f"submitting the {n_left} job(s) not complete yet")

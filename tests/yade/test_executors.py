@@ -58,26 +58,39 @@ class Cluster:
     """`dask scheduler` + `dask worker` processes on 127.0.0.1, stopped at the end."""
 
     def __init__(self, folder, n_workers):
-        self.folder, self.procs, self.workers = Path(folder), [], []
+        self.folder, self.procs, self.workers, self.n_workers = Path(folder), [], [], n_workers
         self.file = self.folder / "scheduler.json"
         self.env = dict(yade_env(), PYTHONUNBUFFERED="1")
-        self.scheduler = self._start(["scheduler", "--host", "127.0.0.1", "--port", "0",
+        self.start(port=0)
+
+    def start(self, port):
+        """The scheduler (on `port`, 0: any) and n single-threaded workers."""
+        self.file.unlink(missing_ok=True)
+        self.scheduler = self._start(["scheduler", "--host", "127.0.0.1", "--port", str(port),
                                       "--dashboard-address", "127.0.0.1:0", "--scheduler-file", str(self.file)],
                                      "scheduler.log")
         deadline = time.time() + 60
         while not self.file.is_file() and time.time() < deadline:
             time.sleep(0.2)
         self.address = json.loads(self.file.read_text())["address"]
-        for i in range(n_workers):       # no nanny: a killed worker stays dead, its job must go elsewhere
+        registered = self.log_count("Registered to")
+        self.workers = []
+        for i in range(self.n_workers):  # no nanny: a killed worker stays dead, its job must go elsewhere
             self.workers.append(self._start(["worker", self.address, "--nthreads", "1", "--no-nanny",
                                              "--name", f"w{i}"], f"worker{i}.log"))
         deadline = time.time() + 60
-        while time.time() < deadline and self.log_count("Registered to") < n_workers:
+        while time.time() < deadline and self.log_count("Registered to") < registered + self.n_workers:
             time.sleep(0.2)
-        assert self.log_count("Registered to") == n_workers, "the workers did not register"
+        assert self.log_count("Registered to") == registered + self.n_workers, "the workers did not register"
+
+    def kill_all(self):
+        """The whole cluster dies at once (scheduler first)."""
+        for proc in [self.scheduler] + self.workers:
+            os.killpg(proc.pid, signal.SIGKILL)
+            proc.wait()
 
     def _start(self, args, log):
-        out = open(self.folder / log, "w")
+        out = open(self.folder / log, "a")
         proc = subprocess.Popen([sys.executable, "-m", "distributed.cli.dask_" + args[0]] + args[1:],
                                 env=self.env, stdout=out, stderr=subprocess.STDOUT, stdin=subprocess.DEVNULL,
                                 cwd=self.folder, start_new_session=True)
@@ -85,7 +98,8 @@ class Cluster:
         return proc
 
     def log_count(self, text):
-        return sum((self.folder / f"worker{i}.log").read_text().count(text) for i in range(len(self.workers)))
+        logs = [self.folder / f"worker{i}.log" for i in range(self.n_workers)]
+        return sum(p.read_text().count(text) for p in logs if p.is_file())
 
     def stop(self):
         for proc in reversed(self.procs):
@@ -150,6 +164,27 @@ def test_dask_job_of_a_killed_worker_runs_elsewhere(tmp_path, cluster, reference
         assert [measurements(r) for r in pool.run(fill_jobs())] == reference
         assert pool.simulated_count == 0
     assert not victim[1].exists() and list((runs / "fill").glob(".*tmp*")) == []
+
+
+def test_dask_study_resumes_when_its_scheduler_restarts(tmp_path, cluster, reference):
+    """Scheduler and workers die mid-job and come back on the same address (as a cluster
+    job restarts them): the executor waits, submits what is not complete, and gets it all."""
+    runs = tmp_path / "runs"
+    ex = DaskExecutor(runs, scheduler=cluster.address, progress=False, reconnect_s=120)
+    out = {}
+    runner = threading.Thread(target=lambda: out.setdefault("results", ex.run(fill_jobs(), raise_on_error=False)))
+    runner.start()
+    deadline = time.time() + 120
+    while time.time() < deadline and not any((p / "yade.log").is_file() for p in (runs / "fill").glob(".fill-*.tmp-*")):
+        time.sleep(0.1)
+    port = int(cluster.address.rsplit(":", 1)[1])
+    cluster.kill_all()
+    time.sleep(2.0)
+    cluster.start(port=port)
+    runner.join(timeout=300)
+    ex.close()
+    assert not runner.is_alive() and ex.last_errors == [] and ex.reconnect_count == 1
+    assert [measurements(r) for r in out["results"]] == reference
 
 
 def test_local_dask_cluster_gives_the_local_pool_numbers(tmp_path, reference):
