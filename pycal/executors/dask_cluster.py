@@ -17,6 +17,7 @@ worker see at the same path (a shared filesystem), and completes there atomicall
 """
 import atexit
 import logging
+import os
 import re
 import time
 import uuid
@@ -158,7 +159,7 @@ class DaskExecutor(Executor):
         return RunError(f"{job['job_id']}: no result on the Dask cluster ({name}: {exc}){hint}")
 
     def _execute(self, todo):
-        runs = self.runs_dir.resolve()
+        runs = Path(os.path.abspath(self.runs_dir))      # the same path on every worker (shared)
         runs.mkdir(parents=True, exist_ok=True)
         client = self._ensure_client()
         pending = {k: self._submit(client, job, runs) for k, job in enumerate(todo)}

@@ -50,7 +50,7 @@ def yade_batch_executable():
 
 def check_table_path(path, what):
     """An absolute path a yade-batch table or log format can carry, or ConfigError."""
-    path = Path(path).resolve()
+    path = Path(os.path.abspath(path))      # as the user named it (a shared path may be a link)
     bad = sorted(set(str(path)) & _BAD_PATH_CHARS)
     if bad:
         raise ConfigError(what, str(path), f"a yade-batch table cannot carry a path with {' '.join(repr(c) for c in bad)} "
