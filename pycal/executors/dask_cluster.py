@@ -19,6 +19,8 @@ import atexit
 import logging
 import os
 import re
+import signal
+import threading
 import time
 import uuid
 from contextlib import contextmanager
@@ -65,6 +67,21 @@ def _quiet_dask():
             l.setLevel(lev)
 
 
+@contextmanager
+def _workers_ignore_ctrl_c():
+    """Processes started inside ignore Ctrl-C (SIGINT), which the terminal sends to the whole
+    process group: the study stops its local cluster itself as it exits, and a worker's
+    YADE runs die with it, so an interrupt prints one line, not a traceback per worker."""
+    if threading.current_thread() is not threading.main_thread():
+        yield
+        return
+    old = signal.signal(signal.SIGINT, signal.SIG_IGN)
+    try:
+        yield
+    finally:
+        signal.signal(signal.SIGINT, old)
+
+
 def run_on_worker(job, runs_dir, timeout_s):
     """The Dask task: run one job on this worker into the shared runs folder."""
     runs = Path(runs_dir)
@@ -108,7 +125,7 @@ class DaskExecutor(Executor):
     def _ensure_client(self):
         if self._client is None:
             distributed = _distributed()
-            with _quiet_dask():
+            with _quiet_dask(), _workers_ignore_ctrl_c():
                 self._cluster = distributed.LocalCluster(n_workers=self.workers, threads_per_worker=1,
                                                          processes=True, dashboard_address="127.0.0.1:0",
                                                          silence_logs=logging.ERROR)
