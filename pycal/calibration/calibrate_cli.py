@@ -24,7 +24,9 @@ def _cmd_calibrate(args):
         # a point runs seeds_count jobs at once: one worker per seed (3 on 2 cores) keeps
         # both cores busy to the end of a point instead of leaving one idle for the last seed
         workers = max(os.cpu_count() or 1, int(load_study(args.config)["seeds_count"]))
-    executor = make_executor(args.executor, runs_dir=runs, workers=workers, timeout_s=args.timeout_s)
+    executor = make_executor(args.executor, scheduler=args.scheduler, runs_dir=runs, workers=workers,
+                             timeout_s=args.timeout_s)
+    # (a Dask executor stops the cluster it started when the process exits)
     study = Study(args.config, executor, Path(args.out or runs / "study"))
     t0 = time.time()
     print(f"calibration study {study.cfg['name']} ({args.config}): {len(study.seeds)} seeds per point, "
@@ -48,12 +50,11 @@ def _cmd_calibrate(args):
 
 
 def register(sub):
+    from ..executors import add_executor_args
     s = sub.add_parser("calibrate", help="run a calibration study (default: the shipped zinc-ore study) "
                                          "and write the calibrated materials and the report")
     s.add_argument("--config", default=str(DEFAULT_STUDY), help="study config (configs/calibrations/*.yaml)")
     s.add_argument("--runs", default=None, help="runs directory: the job cache (default runs/)")
     s.add_argument("--out", default=None, help="study output folder (default <runs>/study)")
-    s.add_argument("--workers", type=int, default=None, help="parallel YADE processes (default: cores, at least seeds_count)")
-    s.add_argument("--executor", default="local", choices=["local", "yade-batch"])
-    s.add_argument("--timeout-s", type=float, default=3600.0, help="timeout per job in seconds")
+    add_executor_args(s, default_workers="cores, at least seeds_count")
     s.set_defaults(func=_cmd_calibrate)
