@@ -14,6 +14,7 @@ from .threads import single_threaded
 
 CANDIDATE_COUNT = 41
 REFERENCE_COUNT = 25
+DISTANCE_SCALE_U = 0.2        # a far candidate keeps exp(-d^2 / 2 0.2^2) of its gain: far points pin a line, but a DEM response need not stay one that far
 LOCAL_MIN_U = 0.2        # candidates reach at least this far (in u) beyond the likely crossings
 
 
@@ -38,11 +39,14 @@ def next_point_1d(model, crossings_u, lo_u, hi_u, runs_count):
     reach = max(0.5 * (b - a), LOCAL_MIN_U)
     cand = np.linspace(max(lo_u, a - reach), min(hi_u, b + reach), CANDIDATE_COUNT)
     gain = variance_reduction(model, ref[:, None], cand[:, None], runs_count)
+    if DISTANCE_SCALE_U:
+        est = float(np.median(c))
+        gain = gain * np.exp(-0.5 * ((cand - est) / DISTANCE_SCALE_U) ** 2)
     return float(cand[int(np.argmax(gain))])
 
 
 @single_threaded
-def next_point_nd(models, samples_u, runs_count, rng, avoid_u=(), avoid_radius=0.1):
+def next_point_nd(models, samples_u, runs_count, rng, avoid_u=(), avoid_radius=0.03):
     """u (d,) of the next point of a joint stage: the candidate (drawn from the posterior
     samples, plus the posterior median) that most reduces the variance of every output,
     each output's reduction relative to its current variance at the samples. Candidates

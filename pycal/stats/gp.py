@@ -81,6 +81,7 @@ class ResponseModel:
         self._noise = np.array([grid[i][0] for i in keep])
         self._bend = np.array([grid[i][1] for i in keep])
         self._length = np.array([grid[i][2] for i in keep])
+        self._lengths, self._length_index = np.unique(self._length, return_inverse=True)
         self._alpha = np.stack([fits[i][1] for i in keep])        # (models, runs)
         self._K_inv = np.stack([fits[i][2] for i in keep])        # (models, runs, runs)
         self.noise_sd = float(sd) if known else float(np.sqrt(np.sum(self.weights * self._noise))) * self.y_scale
@@ -91,12 +92,10 @@ class ResponseModel:
     # ---- kernels of every grid model at once: arrays (models, len(A), len(B))
     def _k(self, A, B):
         AB = A @ B.T
-        K = np.broadcast_to(TREND_PRIOR_VAR * (1.0 + AB), (len(self.weights),) + AB.shape).copy()
-        d2 = np.clip(np.sum(A ** 2, 1)[:, None] + np.sum(B ** 2, 1)[None, :] - 2 * AB, 0.0, None)
-        for length in np.unique(self._length[self._bend > 0]):
-            sel = (self._length == length) & (self._bend > 0)
-            K[sel] += self._bend[sel, None, None] * np.exp(-0.5 * d2 / length ** 2)[None]
-        return K
+        trend = TREND_PRIOR_VAR * (1.0 + AB)
+        d2 = np.maximum(np.sum(A ** 2, 1)[:, None] + np.sum(B ** 2, 1)[None, :] - 2 * AB, 0.0)
+        rbf = np.exp(-0.5 * d2[None, :, :] / self._lengths[:, None, None] ** 2)     # one per length scale
+        return trend[None, :, :] + self._bend[:, None, None] * rbf[self._length_index]
 
     def _latent(self, Us, full_cov):
         """Per grid model: mean (models, n) and variances (models, n) or covariances."""
@@ -107,7 +106,7 @@ class ResponseModel:
         if full_cov:
             return mean, self._k(Xs, Xs) - np.swapaxes(Ks, 1, 2) @ KiKs
         prior = TREND_PRIOR_VAR * (1.0 + np.sum(Xs ** 2, 1))[None, :] + self._bend[:, None]
-        return mean, np.clip(prior - np.sum(Ks * KiKs, axis=1), 0.0, None)
+        return mean, np.maximum(prior - np.sum(Ks * KiKs, axis=1), 0.0)
 
     def mean_var(self, Us):
         """(mean, variance) of f at the points Us (n x d), in y's unit: the uncertainty of
@@ -116,7 +115,7 @@ class ResponseModel:
         w = self.weights[:, None]
         mean = np.sum(w * m, axis=0)
         var = np.sum(w * (v + m ** 2), axis=0) - mean ** 2
-        return mean * self.y_scale + self.y_mean, np.clip(var, 0.0, None) * self.y_scale ** 2
+        return mean * self.y_scale + self.y_mean, np.maximum(var, 0.0) * self.y_scale ** 2
 
     def mean(self, Us):
         """Posterior mean of f at Us."""

@@ -15,12 +15,16 @@ from dataclasses import dataclass
 
 import emcee
 import numpy as np
+from scipy.optimize import minimize
 from .threads import single_threaded
 
 WALKERS_COUNT = 24
-STEPS_COUNT = 600
-BURN_COUNT = 200
+STEPS_COUNT = 400
+BURN_COUNT = 150
 KEEP_COUNT = 4000
+STUCK_NATS = 25.0
+MAP_SEARCH_COUNT = 400      # random points tried for the start of the local searches
+MAP_STARTS_COUNT = 4
 
 
 @dataclass
@@ -51,20 +55,39 @@ def log_likelihood(models, targets, standard_errors, U):
 @single_threaded
 def sample(models, targets, standard_errors, start_u, seed=0, walkers=WALKERS_COUNT, steps=STEPS_COUNT,
            burn=BURN_COUNT, keep=KEEP_COUNT):
-    """Posterior over u from the outputs' response models; start_u: where the walkers start."""
+    """Posterior over u from the outputs' response models; start_u: a good point to start from.
+
+    The walkers start in a tiny ball around the most likely point (scipy local searches
+    from the best of start_u and random points):
+    a posterior pinned by many runs is narrow, and a walker started off it can wander to
+    a far corner where the surrogate is merely vague, and stay (measured on the wet wall
+    fit). A walker whose median log-probability ends more than STUCK_NATS below the
+    others' is dropped as stuck."""
     d = models[0].dim
+
+    def log_p(U):
+        return log_likelihood(models, targets, standard_errors, U)
     rng = np.random.default_rng(seed)
-    start = np.clip(np.asarray(start_u, dtype=float), 0.02, 0.98)
-    p0 = np.clip(start[None, :] + 0.05 * rng.standard_normal((walkers, d)), 0.001, 0.999)
-    sampler = emcee.EnsembleSampler(walkers, d, lambda U: log_likelihood(models, targets, standard_errors, U),
-                                    vectorize=True)
+    # the most likely point: local searches from the best few of start_u and random points
+    # (the surrogate's vague edges can hold local maxima: one search from one start is not enough)
+    tries = np.vstack([np.atleast_2d(start_u), rng.uniform(0.0, 1.0, size=(MAP_SEARCH_COUNT, d))])
+    tries = tries[np.argsort(-log_p(tries))[:MAP_STARTS_COUNT]]
+    found = [minimize(lambda u: -log_p(u[None, :])[0], np.clip(t, 1e-3, 1 - 1e-3), method="L-BFGS-B",
+                      bounds=[(0.0, 1.0)] * d).x for t in tries]
+    cand = np.vstack([tries, found])
+    start = np.clip(cand[int(np.argmax(log_p(cand)))], 1e-3, 1 - 1e-3)
+    p0 = np.clip(start[None, :] + 1e-3 * rng.standard_normal((walkers, d)), 0.0, 1.0)
+    sampler = emcee.EnsembleSampler(walkers, d, log_p, vectorize=True)
     sampler.random_state = np.random.RandomState(seed).get_state()
     sampler.run_mcmc(p0, steps, progress=False)
-    chain = sampler.get_chain(discard=burn, flat=True)
-    if len(chain) > keep:
-        chain = chain[rng.choice(len(chain), size=keep, replace=False)]
-    low, est, high = np.percentile(chain, [2.5, 50.0, 97.5], axis=0)
-    return Posterior(chain, est, low, high, float(np.mean(sampler.acceptance_fraction)))
+    chain = sampler.get_chain(discard=burn)                  # (steps, walkers, d)
+    lp = np.median(sampler.get_log_prob(discard=burn), axis=0)
+    good = lp >= np.median(lp) - STUCK_NATS
+    flat = chain[:, good, :].reshape(-1, d)
+    if len(flat) > keep:
+        flat = flat[rng.choice(len(flat), size=keep, replace=False)]
+    low, est, high = np.percentile(flat, [2.5, 50.0, 97.5], axis=0)
+    return Posterior(flat, est, low, high, float(np.mean(sampler.acceptance_fraction)))
 
 
 def correlation(samples):

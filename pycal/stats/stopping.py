@@ -12,6 +12,7 @@ Only the first counts as met.
 """
 WITHIN = "interval within tolerance"
 BUDGET = "run budget spent"
+STUDY_BUDGET = "study run budget spent"      # the whole study's max_runs_count (said by the driver)
 BEYOND_UPPER = "target beyond the upper bound"
 BEYOND_LOWER = "target beyond the lower bound"
 BOUND_SHARE = 0.025

@@ -144,7 +144,7 @@ def test_joint_next_point_is_inside_the_posterior_and_avoids_refused_points():
     assert all(lo <= x <= hi for lo, x, hi in zip(st.low, st.next_x, st.high))
     again = step_nd([Scale(0, 1), Scale(0, 1)], X, Y, wall(TRUTH[None])[0], [0, 0], [(0.005, False)] * 2,
                     runs_left=30, avoid_x=[st.next_x])
-    assert np.linalg.norm(np.array(again.next_x) - np.array(st.next_x)) > 0.1
+    assert np.linalg.norm(np.array(again.next_x) - np.array(st.next_x)) > 0.03
 
 
 def test_joint_posterior_coverage_over_random_draws():
