@@ -4,15 +4,16 @@ E.g. the wet wall friction (fines-steel friction sets the curve's level, the adh
 its rise with consolidation: one vector response, a band z per lab step), or the final
 pass over rolling resistance and particle density (AoR and bulk density: two rigs).
 
-1. the start point and one step per parameter (a fifth of its bounds, inwards): d + 1
+1. the start point and one step per parameter (a tenth of its bounds, inwards): d + 1
    points, each running every response's rig with seeds_count seeds;
 2. then, until the stop rule: a response model per output over all runs, the posterior
    over the parameters sampled with emcee, and the point (drawn from the posterior)
    that most shrinks the outputs' uncertainty where the posterior lies
    (pycal.stats.sequential.step_nd).
 Reported per parameter: estimate (posterior median), 95 % interval, and the
-correlation matrix. A point the rig refuses is not asked again (nor anything
-closer to it than 3 % of the bounds).
+correlation matrix. A point the rig refuses is not asked again, nor anything closer to
+it than half its distance to the nearest point that ran (in u); a refused first step
+is tried the other way once.
 """
 import math
 
@@ -26,7 +27,7 @@ from ..stats.sequential import step_nd
 from . import plots
 from .study import BudgetSpent
 
-FIRST_STEP_U = 0.2
+FIRST_STEP_U = 0.1      # a tenth of the bounds: a second pass starts from values already close
 
 
 def run(study, material, st):
@@ -54,6 +55,7 @@ def run(study, material, st):
         return e
 
     def point(xs):
+        """Run xs; False when the rig refused it."""
         xs = [round_significant(x) for x in xs]
         try:
             cols = []
@@ -67,10 +69,11 @@ def run(study, material, st):
                 raise
             refused.append((xs, str(exc)))
             study.log(f"  the rig refused {xs}: no point near it is asked again")
-            return
+            return False
         for i in range(n):
             X.append(xs)
             Y.append([v for c in cols for v in c[i]])
+        return True
 
     x0 = [p["start"] if p["start"] is not None else
           min(max(study.current_value(material, p["keys"][0]), p["bounds"][0]), p["bounds"][1]) for p in params]
@@ -81,9 +84,11 @@ def run(study, material, st):
     u0 = [float(s.to_unit(x)) for s, x in zip(scales, x0)]
     try:
         for j in range(len(params)):
-            u = list(u0)
-            u[j] += FIRST_STEP_U if u0[j] <= 0.5 else -FIRST_STEP_U
-            point([float(s.from_unit(v)) for s, v in zip(scales, u)])
+            for sign in ((1, -1) if u0[j] <= 0.5 else (-1, 1)):     # refused: the other way once
+                u = list(u0)
+                u[j] = min(1.0, max(0.0, u[j] + sign * FIRST_STEP_U))
+                if point([float(s.from_unit(v)) for s, v in zip(scales, u)]):
+                    break
         while True:
             step = step_nd(scales, X, Y, targets, ses, tols, runs_left=runs_left(), runs_per_point=per_point,
                            avoid_x=[x for x, _ in refused])

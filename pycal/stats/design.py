@@ -14,6 +14,7 @@ from .threads import single_threaded
 
 CANDIDATE_COUNT = 41
 REFERENCE_COUNT = 25
+AVOID_MIN_U = 0.03          # smallest ball ruled out around a refused point
 DISTANCE_SCALE_U = 0.2        # a far candidate keeps exp(-d^2 / 2 0.2^2) of its gain: far points pin a line, but a DEM response need not stay one that far
 LOCAL_MIN_U = 0.2        # candidates reach at least this far (in u) beyond the likely crossings
 
@@ -46,20 +47,24 @@ def next_point_1d(model, crossings_u, lo_u, hi_u, runs_count):
 
 
 @single_threaded
-def next_point_nd(models, samples_u, runs_count, rng, avoid_u=(), avoid_radius=0.03):
+def next_point_nd(models, samples_u, runs_count, rng, avoid=()):
     """u (d,) of the next point of a joint stage: the candidate (drawn from the posterior
     samples, plus the posterior median) that most reduces the variance of every output,
-    each output's reduction relative to its current variance at the samples. Candidates
-    within avoid_radius of a point the rig refused are left out."""
+    each output's reduction relative to its current variance at the samples (and, as in
+    1-D, a far candidate keeps exp(-d^2 / 2 DISTANCE_SCALE_U^2) of its gain). avoid:
+    (centre, radius) balls in u around points the rig refused: no candidate there."""
     S = np.asarray(samples_u, dtype=float)
     ref = S[rng.choice(len(S), size=min(len(S), 60), replace=False)]
     cand = np.vstack([np.median(S, axis=0)[None, :], S[rng.choice(len(S), size=min(len(S), 80), replace=False)]])
-    for a in avoid_u:
-        cand = cand[np.linalg.norm(cand - np.asarray(a)[None, :], axis=1) > avoid_radius]
+    for centre, radius in avoid:
+        cand = cand[np.linalg.norm(cand - np.asarray(centre)[None, :], axis=1) > radius]
     if not len(cand):
         return None
     score = np.zeros(len(cand))
     for m in models:
         _, var_ref = m.mean_var(ref)
         score += variance_reduction(m, ref, cand, runs_count) / (np.mean(var_ref) + 1e-300)
+    if DISTANCE_SCALE_U:
+        dist = np.linalg.norm(cand - np.median(S, axis=0)[None, :], axis=1)
+        score = score * np.exp(-0.5 * (dist / DISTANCE_SCALE_U) ** 2)
     return cand[int(np.argmax(score))]

@@ -125,9 +125,12 @@ def step_nd(scales, X, Y, targets, standard_errors, tolerances, runs_left=None, 
     elif runs_left is not None and runs_left < runs_per_point:
         out.stop = stopping.BUDGET
     else:
-        avoid_u = [np.array([s.to_unit(a[j]) for j, s in enumerate(scales)]) for a in avoid_x]
-        nxt = design.next_point_nd(models, post.samples_u, runs_per_point, np.random.default_rng(seed),
-                                   avoid_u=avoid_u)
+        # a refused point rules out a ball: half its distance to the nearest point that ran
+        avoid = []
+        for a in avoid_x:
+            ua = np.array([s.to_unit(a[j]) for j, s in enumerate(scales)])
+            avoid.append((ua, max(design.AVOID_MIN_U, 0.5 * float(np.min(np.linalg.norm(U - ua[None, :], axis=1))))))
+        nxt = design.next_point_nd(models, post.samples_u, runs_per_point, np.random.default_rng(seed), avoid=avoid)
         if nxt is None:
             out.stop = "every candidate point lies next to a point the rig refused"
         else:
