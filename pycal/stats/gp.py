@@ -5,10 +5,10 @@
 f is a straight trend with flat priors on intercept and slopes (a Bayesian linear
 regression: the DotProduct kernel) plus a smooth deviation (RBF kernel) of unknown size
 and length scale. Those two hyperparameters are not fitted to one best value, which
-is overconfident with a handful of points: f is averaged over a grid of them, each
-weighted by its marginal likelihood (Bayesian model averaging; scikit-learn fits each
-grid model), so two points give a line with an honest slope uncertainty and more
-points let the curve bend where the data ask for it. The seed noise sd comes from the
+is overconfident with a handful of points: f is averaged over the line and seven
+bends (BENDS), each weighted by its marginal likelihood (Bayesian model averaging, equal
+prior weights; scikit-learn fits each), so two points give a line with an honest slope
+uncertainty and more points let the curve bend where the data ask for it. The seed noise sd comes from the
 runs repeated at the same point (pycal.stats.noise); without repeats it joins the
 grid. y keeps its unit (deg, kg/m3, ...): it is standardised inside.
 
@@ -27,9 +27,10 @@ from .noise import pooled_noise
 from .threads import single_threaded
 
 TREND_PRIOR_VAR = 100.0                   # flat priors: sd 10 x the responses' spread
-BEND_VARS = (0.0, 0.03, 0.3, 3.0)         # size of the deviation from a line (variance, in the responses'
-                                          # spread squared); 0: a straight line
-BEND_LENGTHS = (0.15, 0.3, 0.6)           # its length scale in u (share of the bounds)
+# the deviation from a line: (variance in the responses' spread squared, length scale in u);
+# a large deviation only over a long length: a physical response bends, it does not wiggle
+# (a 1.7-spread bump over 0.15 of the bounds made a noisy density stage's interval explode)
+BENDS = ((0.03, 0.15), (0.03, 0.3), (0.03, 0.6), (0.3, 0.15), (0.3, 0.3), (0.3, 0.6), (3.0, 0.6))
 NOISE_VARS = (0.001, 0.01, 0.1, 1.0)      # without repeated seeds the noise joins the grid
 MIN_WEIGHT = 1e-4                         # grid models below this posterior weight are dropped
 
@@ -68,12 +69,10 @@ class ResponseModel:
         z = (self.y - self.y_mean) / self.y_scale
         self._X = self.U - 0.5                # centred: the trend's intercept is mid-range
         noise_grid = [(sd / self.y_scale) ** 2 + 1e-8] if known else NOISE_VARS
-        grid = [(nv, bv, length) for nv, bv in itertools.product(noise_grid, BEND_VARS)
-                for length in (BEND_LENGTHS if bv > 0 else (1.0,))]
+        shapes = [(0.0, 1.0)] + list(BENDS)
+        grid = [(nv, bv, length) for nv, (bv, length) in itertools.product(noise_grid, shapes)]
         fits = [_fit_component(self._X, z, *g) for g in grid]
-        # prior: each bend size (0 = a line) equally likely, its length scales sharing it
-        prior = np.array([1.0 if bv == 0 else 1.0 / len(BEND_LENGTHS) for _, bv, _ in grid])
-        log_w = np.array([f[0] for f in fits]) + np.log(prior)
+        log_w = np.array([f[0] for f in fits])           # every shape (the line and the bends) equally likely
         w = np.exp(log_w - log_w.max())
         w /= w.sum()
         keep = np.nonzero(w >= MIN_WEIGHT)[0]

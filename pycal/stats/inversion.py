@@ -1,9 +1,10 @@
 """Invert a one-parameter response model for a target: the estimate and its 95 % interval.
 
 Curves f are drawn from the response model's posterior (pycal.stats.gp) on a grid of u
-in [0, 1]; each is made monotone in the direction physics gives (rearranged: its values
-sorted) and crossed with the target, itself drawn from N(target, standard_error^2)
-where the target is a mean of its own (a twin's simulated lab value). The crossings
+in [0, 1]; each is crossed with the target, itself drawn from N(target, standard_error^2)
+where the target is a mean of its own (a twin's simulated lab value), after being made
+monotone in the direction physics gives (rearranged: its values sorted) over the
+stretch the runs constrain. The crossings
 are draws of the parameter that reproduces the target: their median is the estimate,
 their 2.5 and 97.5 percentiles the 95 % interval. A draw that does not cross inside
 the bounds counts at the bound it points past (share reported: p_below, p_above).
@@ -17,6 +18,7 @@ import numpy as np
 from .threads import single_threaded
 
 GRID_COUNT = 101
+WINDOW_MARGIN_U = 0.1      # the stretch made monotone: the runs' range and this much beyond
 DRAW_COUNT = 2000
 
 
@@ -33,14 +35,39 @@ class Inversion:
     band_high_u: float = float("nan")
 
 
-def crossings(curves, grid, targets, increasing):
-    """u where each curve (rows of `curves` on `grid`) first reaches its target, after
-    sorting its values (monotone rearrangement); -inf / +inf when it crosses below /
-    beyond the grid."""
+def crossings(curves, grid, targets, increasing, window=None):
+    """u where each curve (rows of `curves` on `grid`) reaches its target; -inf / +inf when
+    it stays above / below it on the whole grid.
+
+    Each curve is made monotone first (its values sorted: monotone rearrangement) within
+    `window` (lo, hi) in u, the stretch the runs constrain (default: the whole grid); a
+    curve that does not reach its target there gets its first upward crossing beyond it
+    (in the direction physics gives). So a curve that wanders far from the runs, where
+    the model is vague, cannot move the crossing the runs pin down (found: a far dip of
+    a sorted curve moved a wet-cohesion crossing from 1.1 to 4)."""
     F = np.asarray(curves, dtype=float)
     T = np.broadcast_to(np.asarray(targets, dtype=float), (F.shape[0],))
     if not increasing:
         F, T = -F, -T
+    if window is None:
+        return _sorted_crossings(F, grid, T)
+    inside = (grid >= window[0]) & (grid <= window[1])
+    out = _sorted_crossings(F[:, inside], grid[inside], T)
+    D = F - T[:, None]
+    up = (D[:, :-1] < 0) & (D[:, 1:] >= 0)
+    frac = np.where(up, -D[:, :-1] / np.where(up, D[:, 1:] - D[:, :-1], 1.0), 0.0)
+    xc = grid[:-1][None, :] + frac * np.diff(grid)[None, :]
+    for side, beyond in ((np.inf, xc > window[1]), (-np.inf, xc < window[0])):
+        rows = out == side
+        ok = up & beyond & rows[:, None]
+        dist = np.where(ok, np.abs(xc - (window[1] if side > 0 else window[0])), np.inf)
+        has = ok.any(axis=1)
+        out[has] = xc[has, np.argmin(dist[has], axis=1)]
+    return out
+
+
+def _sorted_crossings(F, grid, T):
+    """First crossing of each row of F after sorting it (rows rising with u)."""
     F = np.sort(F, axis=1)
     idx = np.sum(F < T[:, None], axis=1)
     out = np.empty(F.shape[0])
@@ -71,7 +98,9 @@ def invert(model, target, increasing, standard_error=0.0, band=0.0, lo_u=0.0, hi
     grid = np.linspace(lo_u, hi_u, GRID_COUNT)
     curves = model.sample(grid[:, None], draws, rng)
     targets = target + float(standard_error) * rng.standard_normal(draws)
-    c = crossings(curves, grid, targets, increasing)
+    ran = model.U[:, 0]
+    window = (max(lo_u, float(ran.min()) - WINDOW_MARGIN_U), min(hi_u, float(ran.max()) + WINDOW_MARGIN_U))
+    c = crossings(curves, grid, targets, increasing, window=window)
     p_below, p_above = float(np.mean(c == -np.inf)), float(np.mean(c == np.inf))
     c = np.clip(c, lo_u, hi_u)
     low, est, high = np.percentile(c, [2.5, 50.0, 97.5])

@@ -55,10 +55,12 @@ def log_likelihood(models, targets, standard_errors, U):
 @single_threaded
 def sample(models, targets, standard_errors, start_u, seed=0, walkers=WALKERS_COUNT, steps=STEPS_COUNT,
            burn=BURN_COUNT, keep=KEEP_COUNT):
-    """Posterior over u from the outputs' response models; start_u: a good point to start from.
+    """Posterior over u from the outputs' response models; start_u: points to start the
+    search from (one, or rows: e.g. every point run so far).
 
     The walkers start in a tiny ball around the most likely point (scipy local searches
-    from the best of start_u and random points):
+    from the best few of start_u and the best few of MAP_SEARCH_COUNT random points: a
+    posterior pinned by the runs can be narrower than the random points' spacing):
     a posterior pinned by many runs is narrow, and a walker started off it can wander to
     a far corner where the surrogate is merely vague, and stay (measured on the wet wall
     fit). A walker whose median log-probability ends more than STUCK_NATS below the
@@ -70,8 +72,10 @@ def sample(models, targets, standard_errors, start_u, seed=0, walkers=WALKERS_CO
     rng = np.random.default_rng(seed)
     # the most likely point: local searches from the best few of start_u and random points
     # (the surrogate's vague edges can hold local maxima: one search from one start is not enough)
-    tries = np.vstack([np.atleast_2d(start_u), rng.uniform(0.0, 1.0, size=(MAP_SEARCH_COUNT, d))])
-    tries = tries[np.argsort(-log_p(tries))[:MAP_STARTS_COUNT]]
+    near = np.atleast_2d(np.asarray(start_u, dtype=float))
+    far = rng.uniform(0.0, 1.0, size=(MAP_SEARCH_COUNT, d))
+    tries = np.vstack([near[np.argsort(-log_p(near))[:MAP_STARTS_COUNT]],
+                       far[np.argsort(-log_p(far))[:MAP_STARTS_COUNT]]])
     found = [minimize(lambda u: -log_p(u[None, :])[0], np.clip(t, 1e-3, 1 - 1e-3), method="L-BFGS-B",
                       bounds=[(0.0, 1.0)] * d).x for t in tries]
     cand = np.vstack([tries, found])

@@ -67,7 +67,7 @@ def step_1d(scale, x, y, target, increasing, tolerance=None, tolerance_percent=N
     stop = stopping.stop_reason(est, low, high, tol, inv.p_below, inv.p_above,
                                 ran_at_lower=bool(np.any(u <= lo_u + edge)),
                                 ran_at_upper=bool(np.any(u >= hi_u - edge)),
-                                runs_left=runs_left, runs_next=runs_per_point)
+                                runs_left=runs_left, runs_next=runs_per_point, points_count=len(np.unique(u)))
     out = Step1D(est, low, high, tol, inv.p_below, inv.p_above,
                  float(scale.from_unit(inv.band_low_u)) if band else float("nan"),
                  float(scale.from_unit(inv.band_high_u)) if band else float("nan"), stop=stop, model=model)
@@ -110,8 +110,7 @@ def step_nd(scales, X, Y, targets, standard_errors, tolerances, runs_left=None, 
             ses.append(standard_errors[k])
     if not models:
         raise ValueError("no output has values at two distinct points")
-    best = U[int(np.argmin(np.nansum(((Y - np.asarray(targets)[None, :])) ** 2, axis=1)))]
-    post = posterior.sample(models, tgt, ses, best, seed=seed, **sampler_kw)
+    post = posterior.sample(models, tgt, ses, np.unique(U, axis=0), seed=seed, **sampler_kw)
     S = np.column_stack([s.from_unit(post.samples_u[:, j]) for j, s in enumerate(scales)])
     est = [float(v) for v in np.median(S, axis=0)]
     low = [float(v) for v in np.percentile(S, 2.5, axis=0)]
@@ -120,7 +119,7 @@ def step_nd(scales, X, Y, targets, standard_errors, tolerances, runs_left=None, 
     within = all(stopping.within_tolerance(e, lo, hi, t) for e, lo, hi, t in zip(est, low, high, tols))
     out = StepND(est, low, high, tols, posterior.correlation(S).tolist(), samples=S, models=models,
                  acceptance=post.acceptance)
-    if within:
+    if within and len(np.unique(U, axis=0)) >= len(scales) + stopping.MIN_POINTS - 1:
         out.stop = stopping.WITHIN
     elif runs_left is not None and runs_left < runs_per_point:
         out.stop = stopping.BUDGET

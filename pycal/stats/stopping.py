@@ -2,8 +2,10 @@
 
 A stage stops when (checked in this order)
   1. "interval within tolerance": the whole 95 % interval lies within estimate +-
-     tolerance, and no more than 2.5 % of the draws point past either bound (else the
-     interval's end is the bound, not a measured end);
+     tolerance, no more than 2.5 % of the draws point past either bound (else the
+     interval's end is the bound, not a measured end), and at least MIN_POINTS distinct
+     points have run (a line through two points cannot show its own bending: found on a
+     response that jumps where the wet cell starts to hang on);
   2. "target beyond the upper/lower bound": at least 97.5 % of the draws point past
      that bound and a point has been run at it: what the bounds allow cannot reach
      the target;
@@ -16,6 +18,7 @@ STUDY_BUDGET = "study run budget spent"      # the whole study's max_runs_count 
 BEYOND_UPPER = "target beyond the upper bound"
 BEYOND_LOWER = "target beyond the lower bound"
 BOUND_SHARE = 0.025
+MIN_POINTS = 3
 
 
 def within_tolerance(estimate, low, high, tolerance):
@@ -24,9 +27,10 @@ def within_tolerance(estimate, low, high, tolerance):
 
 
 def stop_reason(estimate, low, high, tolerance, p_below=0.0, p_above=0.0, ran_at_lower=False,
-                ran_at_upper=False, runs_left=None, runs_next=0):
+                ran_at_upper=False, runs_left=None, runs_next=0, points_count=MIN_POINTS):
     """The reason to stop now (one of the constants above), or None to go on."""
-    if p_below <= BOUND_SHARE and p_above <= BOUND_SHARE and within_tolerance(estimate, low, high, tolerance):
+    if (p_below <= BOUND_SHARE and p_above <= BOUND_SHARE and points_count >= MIN_POINTS
+            and within_tolerance(estimate, low, high, tolerance)):
         return WITHIN
     if p_above >= 1 - BOUND_SHARE and ran_at_upper:
         return BEYOND_UPPER
