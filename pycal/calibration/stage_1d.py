@@ -56,10 +56,14 @@ def run(study, material, st):
     def extra(x):
         return {**st["rig_overrides"], **{k: x for k in p["keys"]}}
 
-    def point(x):
+    jr = study.stage_journal(material, st)
+
+    def point(x, replay=False):
         """Run x; False when the rig refused it (then the bounds in use shrink)."""
         nonlocal lo_u, hi_u
         x = round_significant(x)
+        if not replay:
+            jr.record(x)
         try:
             vals = study.run_point(material, label, st["rig"], extra(x), response, lab_dir)
         except RunError as exc:
@@ -77,10 +81,27 @@ def run(study, material, st):
         ys.extend(vals)
         return True
 
+    def decide(runs):
+        return step_1d(scale, xs, ys, target.value, p["increasing"],
+                       tolerance=None if p["tolerance_is_percent"] else p["tolerance"],
+                       tolerance_percent=p["tolerance"] if p["tolerance_is_percent"] else None,
+                       standard_error=target.standard_error, band=target.band, runs_left=runs,
+                       runs_per_point=n, lo_u=lo_u, hi_u=hi_u)
+
+    while (x := jr.next_recorded()) is not None:        # a resumed study: the same points again
+        point(x, replay=True)
+    if jr.result and len(set(xs)) >= 2:
+        step = decide(0)
+        for k, v in jr.result.items():                    # the values carried before, exactly
+            setattr(step, k, v)
+        return _row(study, material, st, p, scale, xs, ys, step, target, response, refused, lo_u, hi_u, extra,
+                    lab_dir)
     start = p["start"] if p["start"] is not None else min(max(study.current_value(material, p["keys"][0]),
                                                               p["bounds"][0]), p["bounds"][1])
-    point(start)
-    x0, y0 = round_significant(start), float(np.mean(ys))
+    if not xs:
+        point(start)
+    x0 = round_significant(start)
+    y0 = float(np.mean([y for x, y in zip(xs, ys) if x == x0] or ys))
     u0 = float(scale.to_unit(x0))
     budget_note = ""
     while len(set(xs)) < 2:
@@ -98,24 +119,23 @@ def run(study, material, st):
     if len(set(xs)) < 2:
         return _one_point_row(study, st, target, response, xs, ys, budget_note)
     while True:
-        step = step_1d(scale, xs, ys, target.value, p["increasing"],
-                       tolerance=None if p["tolerance_is_percent"] else p["tolerance"],
-                       tolerance_percent=p["tolerance"] if p["tolerance_is_percent"] else None,
-                       standard_error=target.standard_error, band=target.band, runs_left=runs_left(),
-                       runs_per_point=n, lo_u=lo_u, hi_u=hi_u)
+        step = decide(runs_left())
         if step.stop:
             break
         try:
             point(step.next_x)
         except BudgetSpent:
-            step = step_1d(scale, xs, ys, target.value, p["increasing"],
-                           tolerance=None if p["tolerance_is_percent"] else p["tolerance"],
-                           tolerance_percent=p["tolerance"] if p["tolerance_is_percent"] else None,
-                           standard_error=target.standard_error, band=target.band, runs_left=0,
-                           runs_per_point=n, lo_u=lo_u, hi_u=hi_u)
+            step = decide(0)
             step.stop = stopping.STUDY_BUDGET
             break
-    value = round_significant(step.estimate)
+    step.estimate = round_significant(step.estimate)
+    jr.finish({k: getattr(step, k) for k in ("estimate", "low", "high", "tolerance", "band_low", "band_high", "stop")})
+    return _row(study, material, st, p, scale, xs, ys, step, target, response, refused, lo_u, hi_u, extra, lab_dir)
+
+
+def _row(study, material, st, p, scale, xs, ys, step, target, response, refused, lo_u, hi_u, extra, lab_dir):
+    """The stage's row (and plots) from its runs and final step; carries the value on."""
+    value = step.estimate
     study.set_value(material, p["keys"], value, (value, step.low, step.high))
     mean, var = step.model.mean_var(np.array([[float(scale.to_unit(value))]]))
     row = {

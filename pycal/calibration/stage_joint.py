@@ -54,9 +54,13 @@ def run(study, material, st):
             e.update({k: x for k in p["keys"]})
         return e
 
-    def point(xs):
+    jr = study.stage_journal(material, st)
+
+    def point(xs, replay=False):
         """Run xs; False when the rig refused it."""
         xs = [round_significant(x) for x in xs]
+        if not replay:
+            jr.record(xs)
         try:
             cols = []
             for j, (r, response) in enumerate(zip(st["responses"], resp)):
@@ -75,32 +79,51 @@ def run(study, material, st):
             Y.append([v for c in cols for v in c[i]])
         return True
 
+    while (xs := jr.next_recorded()) is not None:        # a resumed study: the same points again
+        point(xs, replay=True)
     x0 = [p["start"] if p["start"] is not None else
           min(max(study.current_value(material, p["keys"][0]), p["bounds"][0]), p["bounds"][1]) for p in params]
-    point(x0)
+    if not X and not refused:
+        point(x0)
     targets = [t.value for t, w in zip(tgts, widths) for _ in range(w)]       # one per output
     ses = [t.standard_error for t, w in zip(tgts, widths) for _ in range(w)]
     tols = [(p["tolerance"], p["tolerance_is_percent"]) for p in params]
-    u0 = [float(s.to_unit(x)) for s, x in zip(scales, x0)]
-    try:
-        for j in range(len(params)):
-            for sign in ((1, -1) if u0[j] <= 0.5 else (-1, 1)):     # refused: the other way once
-                u = list(u0)
-                u[j] = min(1.0, max(0.0, u[j] + sign * FIRST_STEP_U))
-                if point([float(s.from_unit(v)) for s, v in zip(scales, u)]):
+
+    def decide(runs):
+        return step_nd(scales, X, Y, targets, ses, tols, runs_left=runs, runs_per_point=per_point,
+                       avoid_x=[x for x, _ in refused])
+
+    if jr.result:
+        step = decide(0)
+        for k, v in jr.result.items():                    # the values carried before, exactly
+            setattr(step, k, v)
+    else:
+        u0 = [float(s.to_unit(x)) for s, x in zip(scales, x0)]
+        try:
+            for j in range(len(params)):
+                for sign in ((1, -1) if u0[j] <= 0.5 else (-1, 1)):     # refused: the other way once
+                    u = list(u0)
+                    u[j] = min(1.0, max(0.0, u[j] + sign * FIRST_STEP_U))
+                    xs = [round_significant(float(s.from_unit(v))) for s, v in zip(scales, u)]
+                    if xs in X:                           # run already (replayed)
+                        break
+                    if any(xs == r for r, _ in refused):  # refused already: the other way
+                        continue
+                    if point(xs):
+                        break
+            while True:
+                step = decide(runs_left())
+                if step.stop:
                     break
-        while True:
-            step = step_nd(scales, X, Y, targets, ses, tols, runs_left=runs_left(), runs_per_point=per_point,
-                           avoid_x=[x for x, _ in refused])
-            if step.stop:
-                break
-            point(step.next_x)
-    except BudgetSpent:
-        if len({tuple(x) for x in X}) < 2:
-            raise
-        step = step_nd(scales, X, Y, targets, ses, tols, runs_left=0, runs_per_point=per_point)
-        step.stop = stopping.STUDY_BUDGET
-    values = [round_significant(v) for v in step.estimate]
+                point(step.next_x)
+        except BudgetSpent:
+            if len({tuple(x) for x in X}) < 2:
+                raise
+            step = decide(0)
+            step.stop = stopping.STUDY_BUDGET
+        step.estimate = [round_significant(v) for v in step.estimate]
+        jr.finish({k: getattr(step, k) for k in ("estimate", "low", "high", "tolerance", "correlation", "stop")})
+    values = list(step.estimate)
     for p, v, lo, hi in zip(params, values, step.low, step.high):
         study.set_value(material, p["keys"], v, (v, lo, hi))
     u_est = np.array([[float(s.to_unit(v)) for s, v in zip(scales, values)]])

@@ -24,6 +24,7 @@ from ..post import mean_std
 from ..post import responses as responses_mod
 from ..stats import stopping
 from . import outputs, targets
+from .journal import Journal, fingerprint
 from .names import group_label
 from .study_config import load_study
 
@@ -56,6 +57,7 @@ class Study:
         self._point_seeds = {}       # same key -> seeds used there
         self.last_seeds = []         # seeds actually run by the last _run_seeds (replacements included)
         self.t0 = time.time()
+        self.journal = Journal(self.out / "journal.json")
         # every target now: a broken lab file stops the study before any run
         self.targets = {}
         for mat, stages in self.cfg["materials"].items():
@@ -164,6 +166,13 @@ class Study:
         for part in key.split("."):
             node = node[part]
         return node
+
+    def stage_journal(self, material, st):
+        """The journal of a stage (pycal.calibration.journal), keyed by what it starts from:
+        its config, the seeds, its targets and the material's values so far."""
+        tg = [t.__dict__ for t in self.targets[(material, st["label"])]]
+        return self.journal.stage(f"{material}/{st['label']}",
+                                  fingerprint(st, self.seeds, sorted(self.overrides[material].items()), tg))
 
     def set_value(self, material, keys, value, interval=None):
         """Carry a calibrated value (and its (estimate, low, high)) into the next stages."""

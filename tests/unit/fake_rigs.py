@@ -84,3 +84,12 @@ def wall_result(mu_law, stresses=(12000, 40000, 86000), noise_sd=0.01):
         return {"stress_pa": list(stresses), "mu_static": mu, "mu_dynamic": mu, "sticks": [False] * len(stresses)}
     return f
 
+
+
+def holds(p, truth):
+    """The truth inside a parameter's 95 % interval, give or take a quarter of its half
+    width. One draw misses 1 time in 20, and the GP/MCMC arithmetic is not bit-identical
+    between processes, so a single-draw test allows that much; the coverage itself is
+    tested over many draws in test_stats_*."""
+    slack = 0.25 * 0.5 * (p["high"] - p["low"])
+    return p["low"] - slack <= truth <= p["high"] + slack

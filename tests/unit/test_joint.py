@@ -4,7 +4,7 @@ import math
 
 import pytest
 
-from fake_rigs import FakeRigs, wall_result
+from fake_rigs import FakeRigs, holds, wall_result
 from pycal import labdata
 from pycal.calibration.study import Study
 from pycal.calibration.study_config import load_study
@@ -37,13 +37,6 @@ def quiet(_):
     pass
 
 
-def holds(p, truth):
-    """The truth inside the 95 % interval, give or take a quarter of its half width: one
-    draw misses 1 time in 20 (coverage itself is tested over many draws in test_stats_*)."""
-    slack = 0.25 * 0.5 * (p["high"] - p["low"])
-    return p["low"] - slack <= truth <= p["high"] + slack
-
-
 def wet_wall_rig():
     """mu = steel friction + 3e-4 x pressure_fraction x stress (Pa), seed noise 0.01: the
     wet-fines lab curve (0.40 + 3.5e-6 / Pa x stress) is met at friction 0.40, pressure
@@ -62,8 +55,8 @@ def test_wet_wall_joint_stage_recovers_both_parameters_with_their_trade_off(tmp_
     row = rows[0]
     fric, press = row["parameters"]
     assert fric["label"] == "friction (steel)" and press["label"] == "adhesion pressure fraction (steel)"
-    assert fric["low"] <= 0.40 <= fric["high"] and abs(fric["estimate"] - 0.40) < 0.03
-    assert press["low"] <= 0.0117 <= press["high"] and abs(press["estimate"] - 0.0117) < 0.003
+    assert holds(fric, 0.40) and abs(fric["estimate"] - 0.40) < 0.03
+    assert holds(press, 0.0117) and abs(press["estimate"] - 0.0117) < 0.003
     # raising the friction lifts the whole curve; less adhesion must make up for it
     assert row["correlation"][0][1] < -0.3
     assert row["met"] and row["stop_reason"] == "interval within tolerance"
@@ -128,7 +121,7 @@ def test_a_refused_point_is_not_asked_again_and_the_fit_goes_on(tmp_path):
     refused = [j for j in rig.asked if j["materials"]["M3-wet"]["interactions"]["steel"]["friction_coefficient"] > 0.6]
     assert len(refused) == 3 and "the rig refused" in row["message"]      # one point, its 3 seeds, once
     fric, press = row["parameters"]
-    assert fric["low"] <= 0.40 <= fric["high"] and press["low"] <= 0.0117 <= press["high"]
+    assert holds(fric, 0.40) and holds(press, 0.0117)
 
 
 @pytest.mark.parametrize("old, new, message", [
