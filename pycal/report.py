@@ -32,7 +32,7 @@ def _num(v, unit=""):
     """A number for a table: 4 significant digits, its unit after it."""
     if v is None or (isinstance(v, float) and not math.isfinite(v)):
         return "-"
-    text = f"{v:.4g}"
+    text = f"{v:.4g}".replace("e+0", "e").replace("e+", "e").replace("e-0", "e-")
     u = unit_label(unit) if unit else ""
     return text + (f" {u}" if u and u != "-" else "")
 
@@ -51,7 +51,7 @@ def headline(stages):
     calibrated = [s for s in stages if s["kind"] != "inherit"]
     met = [s for s in calibrated if s["met"]]
     text = (f"{len(met)} of {len(calibrated)} calibrated stages met their tolerance "
-            f"(the whole 95 % interval within +- tolerance of the estimate).")
+            f"(the whole 95 % interval within ± tolerance of the estimate).")
     inherited = [s for s in stages if s["kind"] == "inherit"]
     if inherited:
         text += f" {len(inherited)} value{'s' if len(inherited) > 1 else ''} inherited from other materials."
@@ -75,7 +75,7 @@ def _stage_table(stages):
                 cells += [f"<span class='muted'>{_esc(s.get('message', ''))}</span>", "-", "-", "-"]
             else:
                 cells += [_esc(p["label"]), _num(p["estimate"], p["unit"]),
-                          f"{_num(p['low'])} - {_num(p['high'], p['unit'])}", "+- " + _num(p["tolerance"], p["unit"])]
+                          f"{_num(p['low'])} - {_num(p['high'], p['unit'])}", "± " + _num(p["tolerance"], p["unit"])]
             cells += [str(s.get("runs_requested", "")) if i == 0 else "", verdict if i == 0 else ""]
             rows.append("<tr>" + "".join(f"<td{' class=num' if k in (2, 3, 4, 5) else ''}>{c}</td>"
                                          for k, c in enumerate(cells)) + "</tr>")
@@ -89,11 +89,12 @@ def _stage_detail(study_dir, s):
     for r in s.get("responses") or []:
         if "at_estimate" not in r:
             continue
-        band = f" +- {_num(r['band'])}" if r.get("band") else ""
-        se = f" (standard error {_num(r['standard_error'])})" if r.get("standard_error") else ""
-        lines.append(f"{_esc(r['response'])}: {_num(r['at_estimate'])} +- {_num(1.96 * (r.get('at_estimate_sd') or 0))}"
-                     f" at the estimate vs target {_num(r['target'])}{band} {_esc(unit_label(r.get('unit', '')))}"
-                     f"{se} ({_esc(r.get('target_source', ''))}); seed noise sd {_num(r.get('noise_sd'))}")
+        unit = r.get("unit", "")
+        band = f", lab band ± {_num(r['band'], unit)}" if r.get("band") else ""
+        se = f", its standard error {_num(r['standard_error'], unit)}" if r.get("standard_error") else ""
+        lines.append(f"{_esc(r['response'])}: fitted mean at the estimate {_num(r['at_estimate'])} ± "
+                     f"{_num(1.96 * (r.get('at_estimate_sd') or 0), unit)} (95 %); target {_num(r['target'], unit)}"
+                     f"{band}{se} ({_esc(r.get('target_source', ''))}); seed noise sd {_num(r.get('noise_sd'), unit)}")
     if s.get("correlation") and len(s["parameters"]) > 1:
         names = [p["label"] for p in s["parameters"]]
         pairs = [f"{names[i]} / {names[j]}: {s['correlation'][i][j]:+.2f}"

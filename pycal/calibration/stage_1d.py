@@ -20,6 +20,7 @@ from ..stats import stopping
 from ..stats.scales import Scale, round_significant
 from ..stats.sequential import second_point_u, step_1d
 from . import plots
+from .names import unit_label
 from .study import BudgetSpent
 
 
@@ -158,7 +159,8 @@ def _row(study, material, st, p, scale, xs, ys, step, target, response, refused,
 
 def _message(step, p, scale, xs, ys, target, refused, lo_u, hi_u):
     half = max(step.estimate - step.low, step.high - step.estimate)
-    msg = f"95 % interval within +-{half:.3g} of the estimate; tolerance +-{step.tolerance:.3g}"
+    unit = "" if unit_label(p["unit"]) == "-" else " " + unit_label(p["unit"])
+    msg = f"95 % interval within +-{half:.3g}{unit} of the estimate; tolerance +-{step.tolerance:.3g}{unit}"
     if step.stop in (stopping.BEYOND_UPPER, stopping.BEYOND_LOWER):
         at = float(scale.from_unit(hi_u if step.stop == stopping.BEYOND_UPPER else lo_u))
         near = [y for x, y in zip(xs, ys) if abs(float(scale.to_unit(x)) - float(scale.to_unit(at))) < 0.01]

@@ -25,6 +25,7 @@ from ..stats import stopping
 from ..stats.scales import Scale, round_significant
 from ..stats.sequential import step_nd
 from . import plots
+from .names import unit_label
 from .study import BudgetSpent
 
 FIRST_STEP_U = 0.1      # a tenth of the bounds: a second pass starts from values already close
@@ -144,7 +145,8 @@ def run(study, material, st):
                           for p, v, lo, hi, tol in zip(params, values, step.low, step.high, step.tolerance)],
            "responses": out_resp, "correlation": step.correlation, "met": step.stop == stopping.WITHIN,
            "stop_reason": step.stop, "points_count": len({tuple(x) for x in X}),
-           "message": "; ".join(f"{p['label']}: +-{max(v - lo, hi - v):.3g} (tolerance +-{tol:.3g})"
+           "message": "; ".join(f"{p['label']}: 95 % interval within +-{max(v - lo, hi - v):.3g} "
+                                f"{unit_label(p['unit'])} (tolerance +-{tol:.3g})"
                                 for p, v, lo, hi, tol in zip(params, values, step.low, step.high, step.tolerance))
            + (("; the rig refused " + ", ".join(str(x) for x, _ in refused)) if refused else "")}
     row["plots"] = plots.stage_joint(study, material, st, row, scales, np.array(X), np.array(Y), step, tgts,
