@@ -455,3 +455,21 @@ def test_a_killed_stage_resumes_its_recorded_points_then_decides_on(tmp_path, st
     rows = Study(study_file, resumed, tmp_path / "out", log=quiet).run()
     assert resumed.simulated_count == len(cache) - asked_before        # only runs beyond the kill are new
     assert all(r["met"] for r in rows)
+
+
+def test_calibrate_and_fit_density_commands_run_on_a_fake_executor(tmp_path, study_file, capsys, monkeypatch):
+    from pycal import runner
+    from pycal.cli import main
+    monkeypatch.setattr(runner, "make_executor", lambda name, **kw: FakeRigs())
+    code = main(["calibrate", "--config", str(study_file), "--out", str(tmp_path / "out"), "--runs",
+                 str(tmp_path / "runs"), "--seed-base", "5"])
+    out = capsys.readouterr().out
+    assert code == 0 and "seeds 5, 6, ..." in out and "3 of 3 calibrated stages met their tolerance" in out
+    assert "rolling resistance (M3-dry, steel, PVC) = " in out and (tmp_path / "out" / "twin" / "report.html").is_file()
+    monkeypatch.setattr(runner, "LocalPool", lambda **kw: FakeRigs())
+    code = main(["fit-density", "--material", "M2", "--out", str(tmp_path / "dens"), "--runs", str(tmp_path / "runs")])
+    out = capsys.readouterr().out
+    rho_truth = 1603 / (0.35 * (1 - 0.1 * 0.35))
+    import re
+    estimate = float(re.search(r"^M2: particle density (\S+) kg/m3", out, re.M).group(1))
+    assert code == 0 and abs(estimate - rho_truth) < 50 and "95 % interval" in out
