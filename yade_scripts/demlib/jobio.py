@@ -10,7 +10,6 @@ import datetime
 import json
 import os
 import platform
-import subprocess
 import sys
 import time
 import traceback
@@ -79,16 +78,6 @@ def load_job():
     return job, os.path.dirname(path)
 
 
-def _git(*args):
-    from pycal import REPO_ROOT
-    repo = str(REPO_ROOT)
-    try:
-        return subprocess.run(["git", "-C", repo] + list(args), capture_output=True, text=True,
-                              timeout=10).stdout.strip()
-    except Exception:
-        return ""
-
-
 def provenance():
     """YADE version, git commit, threads, host and times of this run."""
     try:
@@ -101,8 +90,8 @@ def provenance():
         threads, simulated_time, steps = O.numThreads, O.time, O.iter
     except Exception:
         threads = simulated_time = steps = None
-    commit = _git("rev-parse", "HEAD") or "unknown"
-    dirty = bool(_git("status", "--porcelain", "--untracked-files=no"))
+    from pycal.gitinfo import git_commit, git_dirty
+    commit, dirty = git_commit(), git_dirty()
     return {
         "yade_version": yade_version,
         "git_commit": commit,
