@@ -22,8 +22,13 @@ def _cmd_validate(args):
     for m in material_set_names():
         load_material_set(m)
     labdata.load_all()
+    from . import CONFIG_DIR
+    from .calibration.study_config import load_study
+    studies = sorted((CONFIG_DIR / "calibrations").glob("*.yaml"))
+    for path in studies:
+        load_study(path)
     print(f"ok: {len(material_names())} materials, {len(material_set_names())} material sets, "
-          f"{len(rig_names())} rigs, lab data valid")
+          f"{len(rig_names())} rigs, {len(studies)} calibration studies, lab data valid")
 
 
 def _make_jobs(args):
