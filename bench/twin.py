@@ -15,7 +15,7 @@ can be hidden (the others stay at the config's values on both sides):
 Per twin:
 1. simulate the lab targets with the hidden values on seeds 101, 102, ... (not the
    study's): cell-fill bulk density, angle of repose (lift 10 mm/s as the study), the
-   CCS-expansion unloading stiffness curve and the wall friction curve (12, 40, 86 kPa),
+   CCS-expansion unloading stiffness curve and the wall friction curve (12, 40, 90 kPa: the study's steps),
    the curves written to <out>/<twin>/twin_lab/ in the labresults/ format; each target
    carries its standard error (it is a mean over the target seeds);
 2. calibrate M2 from its start values with the shipped study's M2 stages for the hidden
@@ -62,7 +62,7 @@ HIDDEN_KEYS = {"particle_density_kg_m3": ["particles.density_kg_m3"],
 STAGE_OF = {"particle_density_kg_m3": "density", "rolling_resistance_coefficient": "rolling_resistance",
             "youngs_modulus_pa": "stiffness", "steel_friction_coefficient": "wall_friction"}
 LIFT = {"rig.procedure.lift_speed_m_s": 0.01}
-WALL_STEPS = {"rig.procedure.consolidation_stresses_pa": [12000, 40000, 86000]}
+WALL_STEPS = {"rig.procedure.consolidation_stresses_pa": [12000, 40000, 90000]}
 
 
 class TwinError(Exception):
