@@ -111,6 +111,37 @@ def _stage_detail(study_dir, s):
     return "\n".join(parts)
 
 
+def _validation(study_dir, rows):
+    """The 'predicted' section: tests the calibration never saw, run with the calibrated values."""
+    if not rows:
+        return []
+    parts = ["<h2>Predicted (validation: nothing fitted to these tests)</h2>",
+             "<table><tr><th>prediction</th><th>response</th><th>predicted (mean +- SD, n)</th><th>lab +- band</th>"
+             "<th>z</th><th>verdict</th></tr>"]
+    for r in rows:
+        if r.get("error"):
+            parts.append(f"<tr><td>{_esc(r['prediction'])}</td><td colspan=5>runs failed: {_esc(r['error'])}</td></tr>")
+            continue
+        for c in r["comparisons"]:
+            lab = "-" if c["lab"] is None else f"{_num(c['lab'])} +- {_num(c['band'])}"
+            parts.append(f"<tr><td>{_esc(r['prediction'])} ({_esc(r['material'])}, {_esc(r['rig'])})</td>"
+                         f"<td>{_esc(c['response'])}</td><td class=num>{_num(c['sim_mean'])} +- {_num(c['sim_sd'])} "
+                         f"({c['n']})</td><td class=num>{lab}</td><td class=num>{_num(c['z'])}</td>"
+                         f"<td>{'inside the lab band' if c['inside'] else 'missed'}</td></tr>")
+    parts.append("</table>")
+    for r in rows:
+        if r.get("sensitivity"):
+            parts.append(f"<p>{_esc(r['prediction'])}: what drives the miss (each calibrated value moved, change of "
+                         f"{_esc(next(c['response'] for c in r['comparisons'] if not c['inside']))}):</p><ul>")
+            for x in r["sensitivity"][:6]:
+                change = "runs failed" if x["change"] is None else f"{x['change']:+.3g}"
+                parts.append(f"<li>{_esc(x['parameter'])} {_num(x['value'])} -> {_num(x['moved_to'])}: {change}</li>")
+            parts.append("</ul>")
+        if r.get("plot") and (study_dir / r["plot"]).is_file():
+            parts.append(_img(study_dir, r["plot"]))
+    return parts
+
+
 def write_report(study_dir):
     """Write <study_dir>/report.html from summary.json and the plots; returns its path."""
     study_dir = Path(study_dir)
@@ -138,6 +169,7 @@ def write_report(study_dir):
                      f"<td class=num>{c['runs_simulated']}</td><td class=num>{c['elapsed_s']:.0f}</td></tr>")
     parts.append("</table><h2>Stages</h2>")
     parts += [_stage_detail(study_dir, s) for s in stages if s["kind"] != "inherit"]
+    parts += _validation(study_dir, summary.get("predicted") or [])
     parts.append("<h2>Calibrated material files</h2>")
     for mat, ov in summary["overrides"].items():
         iv = summary.get("intervals", {}).get(mat, {})

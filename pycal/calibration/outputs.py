@@ -70,7 +70,13 @@ def write_all(study):
                      [[_cell(p[c]) for c in POINT_COLUMNS] for p in study.points])
     write_csv(out / "runs.csv", RUN_COLUMNS, [[_cell(r[c]) for c in RUN_COLUMNS] for r in study.runs])
     summary = {"study": study.cfg["raw"], "config_file": str(study.config_path), "seeds": study.seeds,
-               "seed_base": study.seed_base, "stages": study.stage_rows, "history": study.points,
+               "seed_base": study.seed_base,
+               # what the calibration fitted ("calibrated on") and what it predicts with those values
+               "calibrated_on": [{"material": r["material"], "stage": r["stage"], "kind": r["kind"],
+                                  "responses": [x.get("response") for x in r.get("responses", [])]}
+                                 for r in study.stage_rows if r["kind"] != "inherit"],
+               "predicted": getattr(study, "validation_rows", []),
+               "stages": study.stage_rows, "history": study.points,
                "runs": study.runs, "overrides": study.overrides, "intervals": study.intervals,
                "runs_requested": study.runs_requested, "elapsed_s": time.time() - study.t0,
                "yade_versions": sorted(study.yade_versions), "git_commit": git_commit()}

@@ -51,6 +51,7 @@ class Study:
         self.overrides = {m: {} for m in self.cfg["materials"]}
         self.intervals = {m: {} for m in self.cfg["materials"]}   # key -> (estimate, low, high) found so far
         self.stage_rows, self.points, self.runs = [], [], []
+        self.validation_rows = []    # predictions of tests the calibration never saw (validation.py)
         self.runs_requested = 0
         self.yade_versions = set()
         self.point_results = {}      # (material, stage, rig, point json) -> results of that point
@@ -243,6 +244,9 @@ class Study:
                 if not row["parameters"]:
                     self.log(f"  -> not met: {row['message']}")
                 outputs.write_all(self)
+        from . import validation
+        self.validation_rows = validation.run(self)      # predictions with the calibrated values
+        outputs.write_all(self)
         return self.stage_rows
 
     def calibrated_material(self, material):
