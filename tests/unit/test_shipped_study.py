@@ -9,7 +9,7 @@ import random
 
 import pytest
 
-from fake_rigs import FakeRigs, wall_result
+from fake_rigs import FakeRigs, aor_law, wall_result
 from pycal.calibration.calibrate_cli import DEFAULT_STUDY
 from pycal.calibration.study import Study
 from pycal.post import responses
@@ -37,6 +37,26 @@ def internal(job):
             "mu_dynamic": [None if st else m for m, st in zip(mu, sticks)], "sticks": sticks}
 
 
+def mixed_pile(job):
+    """The mixed -50 mm pile (validation): every direction and the upper part at 35 deg."""
+    return {k: 35.0 for k in ("aor_left_deg", "aor_right_deg", "aor_front_deg", "aor_back_deg",
+                              "aor_upper_left_deg", "aor_upper_right_deg")}
+
+
+def surcharge(job):
+    """The surcharge angle (validation): 0.6 x the fake AoR law."""
+    a = 0.6 * aor_law(job)
+    return {"surcharge_left_deg": a, "surcharge_right_deg": a}
+
+
+def ucs(job):
+    """A UCS stand-in on the lab's own curve shape (validation): bulk stiffness 60 x stress,
+    bulk density 2750 - 1149 exp(-stress / 150 kPa)."""
+    stress = [3000.0, 6000.0, 12000.0, 24000.0, 40000.0]
+    return {"stress_pa": stress, "stiffness_pa": [60 * s for s in stress],
+            "bulk_density_kg_m3": [2750 - 1149 * math.exp(-s / 150000) for s in stress]}
+
+
 def wall(steel, s):
     coh = steel["cohesion"]
     return steel["friction_coefficient"] + (3e-4 * coh.get("pressure_fraction", 0.0) * s
@@ -55,7 +75,8 @@ def test_the_shipped_study_runs_every_stage_on_fake_rigs(tmp_path, fake_stiffnes
     def wall_rig(job):
         stresses = job["rig_config"]["procedure"]["consolidation_stresses_pa"]
         return wall_result(wall, stresses=tuple(stresses))(job)
-    ex = FakeRigs(results={"ccs_expansion": stiffness, "internal_friction": internal, "wall_friction": wall_rig},
+    ex = FakeRigs(results={"ccs_expansion": stiffness, "internal_friction": internal, "wall_friction": wall_rig,
+                           "aor_mixed": mixed_pile, "surcharge": surcharge, "ucs": ucs},
                   noise={"fake_log_ratio": 0.03})
     study = Study(DEFAULT_STUDY, ex, tmp_path / "out", log=lambda m: None, seed_base=7)
     rows = study.run()
@@ -74,5 +95,13 @@ def test_the_shipped_study_runs_every_stage_on_fake_rigs(tmp_path, fake_stiffnes
     assert [p["label"] for p in final["parameters"]] == ["rolling resistance (M2, steel, PVC)", "particle density"]
     assert len(final["correlation"]) == 2
     assert all(j["seed"] >= 7 for j in ex.asked)
+    # validation: every prediction of the shipped config ran with the calibrated values
+    names = [r["prediction"] for r in study.validation_rows]
+    assert names == [p["name"] for p in study.cfg["validation"]["predictions"]]
+    dry = next(r for r in study.validation_rows if r["prediction"] == "mixed_dry_pile")
+    assert dry["comparisons"][0]["sim_mean"] == pytest.approx(35.0, abs=2.0)
+    assert all(j["seed"] >= 7 for j in ex.asked if j["rig"] == "aor_mixed")
+    fines = next(r for r in study.validation_rows if r["prediction"] == "fines_dry_ucs")
+    assert fines["comparisons"][0]["n"] > 0 and fines["comparisons"][0]["inside"]
     html = write_report(study.out).read_text()
     assert "YADE 2023.02a-fake" in html and "rolling_density_final" in html
