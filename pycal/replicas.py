@@ -173,7 +173,22 @@ class ReplicaExecutor:
         self.last_errors = []
 
     def __getattr__(self, name):           # runs_dir, workers, timeout_s ... of the inner executor
+        if name == "inner":                # (not set yet: no recursion while unpickling)
+            raise AttributeError(name)
         return getattr(self.inner, name)
+
+    def close(self):
+        """Close the inner executor (a Dask cluster it started)."""
+        close = getattr(self.inner, "close", None)
+        if close:
+            close()
+
+    def __enter__(self):
+        return self
+
+    def __exit__(self, *exc):
+        self.close()
+        return False
 
     def plan(self, jobs):
         """plan() with the inner executor's workers."""
@@ -181,7 +196,15 @@ class ReplicaExecutor:
 
     def run(self, jobs, raise_on_error=True):
         from .runner import cached_failure, cached_result
-        plan = self.plan(jobs)
+        # an executor without a runs folder (a stand-in) cannot read batch results: no batches
+        plan = self.plan(jobs) if hasattr(self.inner, "runs_dir") else [(j, [i]) for i, j in enumerate(jobs)]
+        if not any(is_batch(j) for j, _ in plan):      # nothing to batch: the inner executor as it is
+            before = getattr(self.inner, "simulated_count", 0)
+            try:
+                return self.inner.run(jobs, raise_on_error=raise_on_error)
+            finally:
+                self.simulated_count += getattr(self.inner, "simulated_count", 0) - before
+                self.last_errors = list(getattr(self.inner, "last_errors", []))
         runs_dir = self.inner.runs_dir
         to_simulate = sum(len(idx) for job, idx in plan
                           if cached_result(job, runs_dir) is None and cached_failure(job, runs_dir) is None)

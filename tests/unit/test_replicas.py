@@ -47,7 +47,7 @@ def fake_yade(tmp_path, monkeypatch):
     exe = tmp_path / "fake-yade"
     exe.write_text(FAKE_YADE)
     exe.chmod(exe.stat().st_mode | stat.S_IEXEC)
-    monkeypatch.setattr(runner, "YADE", str(exe))
+    monkeypatch.setenv("PYCAL_YADE", str(exe))
     count = tmp_path / "count"
     count.write_text("")
     monkeypatch.setenv("FAKE_COUNT", str(count))

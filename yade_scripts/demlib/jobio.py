@@ -10,7 +10,6 @@ import datetime
 import json
 import os
 import platform
-import subprocess
 import sys
 import time
 import traceback
@@ -34,38 +33,50 @@ class OverlapLimitExceeded(RigFailure):
     early with a valid partial result (UCS loading) catch this one."""
 
 
+class JobFileError(Exception):
+    """The job file cannot be found or read (a usage error, not a rig failure)."""
+
+
+USAGE = "usage: yade -j1 -x -n yade_scripts/<rig>.py path/to/job.json (or a yade-batch table line with a jobFile column)"
+
+
 def job_path_from_argv():
-    """The job file: yade-batch's table column `jobFile`, else the first script argument."""
-    try:
+    """The job file: from yade-batch's table line (column `jobFile`) when YADE runs a
+    table line (YADE_BATCH is set), else the first script argument."""
+    batch_line = os.environ.get("YADE_BATCH", "")
+    if batch_line:
         from yade import utils
-        utils.readParamsFromTable(jobFile="", noTableOk=True)
+        try:
+            utils.readParamsFromTable(jobFile="", noTableOk=True)
+        except Exception as exc:       # YADE raises NameError, SyntaxError, RuntimeError, OSError...
+            raise JobFileError(f"yade-batch table line {batch_line}: cannot read it ({type(exc).__name__}: {exc}); "
+                               f"the table has the columns description and jobFile, jobFile a quoted path "
+                               f"such as '/abs/runs/fill/<job_id>/job.json'") from None
         from yade.params import table
-        if getattr(table, "jobFile", ""):
-            return table.jobFile
-    except Exception:
-        pass
+        path = getattr(table, "jobFile", "")
+        if not isinstance(path, str) or not path:
+            raise JobFileError(f"yade-batch table line {batch_line}: no jobFile column (or an empty one): "
+                               f"each line names its job file ('pycal batch-table' writes such tables)")
+        return path
     args = [a for a in sys.argv[1:] if not a.startswith("-")]
     if not args:
-        raise SystemExit("usage: yade -j1 -x -n yade_scripts/<rig>.py path/to/job.json")
+        raise JobFileError(USAGE)
     return args[0]
 
 
 def load_job():
     """(job dict, output folder)."""
     path = os.path.abspath(job_path_from_argv())
-    with open(path) as f:
-        job = json.load(f)
-    return job, os.path.dirname(path)
-
-
-def _git(*args):
-    from pycal import REPO_ROOT
-    repo = str(REPO_ROOT)
     try:
-        return subprocess.run(["git", "-C", repo] + list(args), capture_output=True, text=True,
-                              timeout=10).stdout.strip()
-    except Exception:
-        return ""
+        with open(path) as f:
+            job = json.load(f)
+    except OSError as exc:
+        raise JobFileError(f"job file {path}: cannot read it ({exc.strerror})") from None
+    except ValueError as exc:
+        raise JobFileError(f"job file {path}: not valid JSON ({exc})") from None
+    if not isinstance(job, dict):
+        raise JobFileError(f"job file {path}: not a job (a JSON object is expected)")
+    return job, os.path.dirname(path)
 
 
 def provenance():
@@ -80,8 +91,8 @@ def provenance():
         threads, simulated_time, steps = O.numThreads, O.time, O.iter
     except Exception:
         threads = simulated_time = steps = None
-    commit = _git("rev-parse", "HEAD") or "unknown"
-    dirty = bool(_git("status", "--porcelain", "--untracked-files=no"))
+    from pycal.gitinfo import git_commit, git_dirty
+    commit, dirty = git_commit(), git_dirty()
     return {
         "yade_version": yade_version,
         "git_commit": commit,
@@ -136,6 +147,10 @@ def run_rig(main):
     out_dir = None
     try:
         job, out_dir = load_job()
+    except JobFileError as exc:
+        print(f"RIG FAILED: {exc}", flush=True)
+        os._exit(EXIT_ERROR)
+    try:
         measurements = main(job, out_dir)
         write_result(out_dir, job, measurements)
     except RigFailure as exc:
