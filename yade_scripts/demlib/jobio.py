@@ -17,6 +17,7 @@ import traceback
 
 _T0 = time.time()
 _STARTED = datetime.datetime.now(datetime.timezone.utc).isoformat(timespec="seconds")
+_JOB_DIR = None       # folder of the job file being run (load_job), where every output goes
 
 
 from pycal.contact_rules import law_of_job
@@ -51,10 +52,18 @@ def job_path_from_argv():
 
 def load_job():
     """(job dict, output folder)."""
+    global _JOB_DIR
     path = os.path.abspath(job_path_from_argv())
     with open(path) as f:
         job = json.load(f)
-    return job, os.path.dirname(path)
+    _JOB_DIR = os.path.dirname(path)
+    return job, _JOB_DIR
+
+
+def job_folder():
+    """The folder of the job being run (the current directory if no job file was loaded:
+    test scenes)."""
+    return _JOB_DIR or os.getcwd()
 
 
 def _git(*args):
@@ -134,6 +143,10 @@ def run_rig(main):
     try:
         job, out_dir = load_job()
         measurements = main(job, out_dir)
+        from . import vtk_output
+        snapshots = vtk_output.finish()
+        if snapshots is not None:
+            measurements["vtk_snapshots_count"] = snapshots
         write_result(out_dir, job, measurements)
     except RigFailure as exc:
         print(f"RIG FAILED: {exc}", flush=True)

@@ -12,6 +12,7 @@ from yade import Vector3
 
 from .contact_models import make_contact_model
 from .jobio import RigFailure, OverlapLimitExceeded
+from . import vtk_output
 
 
 class Scene:
@@ -26,6 +27,7 @@ class Scene:
         self.num = self.rig["numerics"]
         self.g = self.num["gravity_m_s2"]
         self.material = job["material"]
+        vtk_output.end_scene()       # a scene before this one (a fresh fill per step) writes its last snapshot
         O.reset()
         random.seed(job["seed"])
         self.contact = make_contact_model(job, gravity=self.g)   # the law of pycal.contact_rules.law_of_job
@@ -37,6 +39,7 @@ class Scene:
             InsertionSortCollider(self.contact.bounding_functors()),
             InteractionLoop(self.contact.geometry_functors(), self.contact.ip2_functors(), [self.contact.law2()]),
         ] + self.contact.extra_engines() + [self.newton]
+        vtk_output.begin_scene(job)  # VTK snapshots for ParaView when the job asks for them (--vtk)
         self.sphere_ids = []
         self.box_min = Vector3(-1, -1, -1)   # rig's bounding box for the escape guard (set by geometry)
         self.box_max = Vector3(1, 1, 1)
