@@ -5,7 +5,7 @@ set -euo pipefail
 cd "$(dirname "$(readlink -f "$0")")"
 
 PY=/usr/bin/python3          # Debian's interpreter: the one YADE runs on (never the first python3 on PATH)
-DEB_PACKAGES="yade python3-numpy python3-scipy python3-pandas python3-matplotlib python3-yaml python3-pytest git"
+DEB_PACKAGES="yade python3-numpy python3-scipy python3-pandas python3-matplotlib python3-yaml python3-pytest python3-distributed python3-sklearn python3-emcee git"   # distributed: the Dask executor; sklearn, emcee: the calibration's response models and posteriors (pycal/stats)
 
 usage() {
   cat <<'USAGE'

@@ -40,11 +40,6 @@ BENCHES = {
 RESULTS = Path(__file__).resolve().parent / "results.jsonl"
 
 
-def _git_commit():
-    """Short commit hash (bench/twin.py imports this name)."""
-    return git_commit(short=True)
-
-
 def run_bench(name, runs=3):
     rig, material, overrides, seed = BENCHES[name]
     job = resolve_job(rig, material, overrides, seed=seed)
@@ -75,7 +70,7 @@ def run_bench(name, runs=3):
         "steps": steps, "n_particles_final": n,
         "particle_steps_per_s": round(n * steps / wall, 1) if wall > 0 else None,
         "ms_per_step": round(1000 * wall / steps, 4) if steps else None,
-        "git_commit": _git_commit(), "host": platform.node(),
+        "git_commit": git_commit(short=True), "host": platform.node(),
         "date_utc": datetime.datetime.now(datetime.timezone.utc).isoformat(timespec="seconds"),
     }
     with open(RESULTS, "a") as f:

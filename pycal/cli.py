@@ -22,8 +22,13 @@ def _cmd_validate(args):
     for m in material_set_names():
         load_material_set(m)
     labdata.load_all()
+    from . import CONFIG_DIR
+    from .calibration.study_config import load_study
+    studies = sorted((CONFIG_DIR / "calibrations").glob("*.yaml"))
+    for path in studies:
+        load_study(path)
     print(f"ok: {len(material_names())} materials, {len(material_set_names())} material sets, "
-          f"{len(rig_names())} rigs, lab data valid")
+          f"{len(rig_names())} rigs, {len(studies)} calibration studies, lab data valid")
 
 
 def _make_jobs(args):
@@ -39,33 +44,58 @@ def _make_jobs(args):
 
 def _cmd_run(args):
     from .runner import make_executor
+    from .replicas import ReplicaExecutor, result_folder
     jobs = _make_jobs(args)
-    ex = make_executor(args.executor, runs_dir=args.out, workers=args.workers,
-                       timeout_s=args.timeout_s)
-    results = ex.run(jobs)
+    inner = make_executor(args.executor, scheduler=args.scheduler, runs_dir=args.out, workers=args.workers,
+                          timeout_s=args.timeout_s)
+    with ReplicaExecutor(inner, args.replicas, args.replica_layout) as ex:
+        results = ex.run(jobs)
     from . import post
+    n_jobs = len({j["job_id"] for j in jobs})
+    print(f"{n_jobs} job(s): {n_jobs - ex.simulated_count} cached, {ex.simulated_count} simulated")
     for job, res in zip(jobs, results):
-        print(f"{job['job_id']}: {args.out}/{job['rig']}/{job['job_id']}")
+        print(f"{res.get('job_id', job['job_id'])}: {result_folder(res, job, args.out)}")
         print("  " + post.summary_line(res))
     if len(results) > 1:
         print(post.seed_statistics_text(results))
 
 
 def _cmd_batch_table(args):
-    from .runner import write_batch_table, _prepare
+    import os
+    from .executors.yade_batch import prepare_batch_table, shell_line
     jobs = _make_jobs(args)
-    rows = []
-    for job in jobs:
-        tmp, final = _prepare(job, args.out)
-        rows.append((job["job_id"], tmp / "job.json"))
-    write_batch_table(args.table, rows)
-    print(f"wrote {args.table}: run with  yade-batch -j2 --job-threads 1 {args.table} "
-          f"yade_scripts/{jobs[0]['script']}")
+    workers = args.workers or os.cpu_count() or 1
+    rows, complete, refused, cmd = prepare_batch_table(jobs, args.out, args.table, workers)
+    for msg in refused:
+        print(f"left out (the rig refused it before): {msg}")
+    if not rows:
+        print(f"nothing to run: {len(complete)} job(s) complete, {len(refused)} refused; no table written")
+        return
+    print(f"wrote {args.table}: {len(rows)} job(s) (job folders under {args.out}/{jobs[0]['rig']}/"
+          + (f"; {len(complete)} complete job(s) left out" if complete else "") + ")")
+    print("run it from any folder with:\n  " + shell_line(cmd))
+    print("each line's log goes to its job folder (yade.log); then `pycal run` (or ./run.sh calibrate) "
+          "with the same jobs reads the results from there")
 
 
 def _cmd_job(args):
     jobs = _make_jobs(args)
-    print(json.dumps(jobs[0], indent=1, sort_keys=True))
+    if not args.write:
+        print(json.dumps(jobs[0], indent=1, sort_keys=True))
+        return
+    import shlex
+    from . import SCRIPT_DIR
+    from .executors.jobdirs import cached_result, create_job_folder
+    from .executors.yade_process import yade_command
+    from .executors.yade_batch import shell_line
+    for job in jobs:
+        folder = create_job_folder(job, args.out)
+        if cached_result(job, args.out) is not None:
+            print(f"{job['job_id']}: complete ({folder}/result.json)")
+            continue
+        cmd = yade_command(SCRIPT_DIR / job["script"], folder / "job.json")
+        print(f"{job['job_id']}: {folder}/job.json; run it with\n  "
+              f"{shell_line(cmd)} 2>&1 | tee {shlex.quote(str(folder / 'yade.log'))}")
 
 
 def _cmd_analyse(args):
@@ -79,7 +109,7 @@ def _cmd_impact(args):
 
 
 def build_parser():
-    from .runner import DEFAULT_RUNS_DIR
+    from .executors import DEFAULT_RUNS_DIR, add_executor_args
     p = argparse.ArgumentParser(prog="pycal", description="DEM calibration toolkit (YADE)")
     sub = p.add_subparsers(dest="command", required=True)
 
@@ -103,18 +133,22 @@ def build_parser():
 
     s = sub.add_parser("run", help="run one rig job (or several seeds) in YADE")
     job_args(s)
-    s.add_argument("--workers", type=int, default=None, help="parallel YADE processes (default: cores)")
-    s.add_argument("--executor", default="local", choices=["local", "yade-batch"])
-    s.add_argument("--timeout-s", type=float, default=3600.0, help="timeout per job in seconds")
+    add_executor_args(s)
     s.set_defaults(func=_cmd_run)
 
-    s = sub.add_parser("job", help="print the resolved job file (no run)")
+    s = sub.add_parser("job", help="print the resolved job file (no run); --write creates its job folder")
     job_args(s)
+    s.add_argument("--write", action="store_true",
+                   help="create runs/<rig>/<job_id>/job.json (each seed) and print the command that runs it "
+                        "by hand; the rig writes result.json there, so pycal run finds it complete")
     s.set_defaults(func=_cmd_job)
 
-    s = sub.add_parser("batch-table", help="write the jobs as a yade-batch table")
+    s = sub.add_parser("batch-table", help="write the job folders and a yade-batch table of the jobs, and "
+                                           "print the yade-batch command that runs it")
     job_args(s)
     s.add_argument("--table", required=True, help="table file to write")
+    s.add_argument("--workers", type=int, default=None,
+                   help="parallel YADE processes in the printed command (default: cores)")
     s.set_defaults(func=_cmd_batch_table)
 
     s = sub.add_parser("analyse", help="lab analysis: moisture, densities, belt load, rolling "

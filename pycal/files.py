@@ -7,6 +7,7 @@ removed and the error goes on to the caller.
 import contextlib
 import csv
 import json
+import math
 import os
 from pathlib import Path
 
@@ -19,6 +20,7 @@ def atomic_path(path):
     is removed. For writers that take a file name (e.g. fig.savefig, DataFrame.to_csv:
     give them the format explicitly, the temporary name ends in .part)."""
     path = Path(path)
+    path.parent.mkdir(parents=True, exist_ok=True)
     tmp = path.with_name(path.name + PART_SUFFIX)
     try:
         yield tmp
@@ -36,10 +38,30 @@ def write_text(path, text):
     return path
 
 
-def write_json(path, data, indent=1, sort_keys=True):
+def finite(obj):
+    """obj with every NaN / infinite float replaced by None, through dicts and lists (so
+    that it can be written as JSON, which has no NaN)."""
+    if isinstance(obj, float):
+        return obj if math.isfinite(obj) else None
+    if isinstance(obj, dict):
+        return {str(k): finite(v) for k, v in obj.items()}
+    if isinstance(obj, (list, tuple)):
+        return [finite(v) for v in obj]
+    return obj
+
+
+def write_bytes(path, data):
+    """Write bytes atomically. Returns path."""
+    with atomic_path(path) as tmp:
+        tmp.write_bytes(data)
+    return path
+
+
+def write_json(path, data, indent=1, sort_keys=True, default=None):
     """Write strict JSON atomically (NaN or infinity is an error: JSON has neither; write
-    None for 'no value'). Returns path."""
-    return write_text(path, json.dumps(data, indent=indent, sort_keys=sort_keys, allow_nan=False) + "\n")
+    None for 'no value'); `default` converts other objects (e.g. str). Returns path."""
+    return write_text(path, json.dumps(data, indent=indent, sort_keys=sort_keys, allow_nan=False,
+                                       default=default) + "\n")
 
 
 def write_csv(path, header, rows):

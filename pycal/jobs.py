@@ -179,8 +179,12 @@ def canonical_json(obj):
     return json.dumps(obj, sort_keys=True, separators=(",", ":"), allow_nan=False)
 
 
+def content_digest(job):
+    """12 hex of the SHA-256 of the job's canonical JSON (job_id itself excluded)."""
+    body = {k: v for k, v in job.items() if k != "job_id"}
+    return hashlib.sha256(canonical_json(body).encode()).hexdigest()[:12]
+
+
 def job_id(job):
     """'<rig>-<material>-s<seed>-<12 hex of the content hash>' (job_id itself excluded)."""
-    body = {k: v for k, v in job.items() if k != "job_id"}
-    digest = hashlib.sha256(canonical_json(body).encode()).hexdigest()[:12]
-    return f"{job['rig']}-{job['material']}-s{job['seed']}-{digest}"
+    return f"{job['rig']}-{job['material']}-s{job['seed']}-{content_digest(job)}"

@@ -1,138 +1,193 @@
 """The study report: one self-contained HTML page (plots embedded) from a study folder.
 
-Reads <study>/summary.json (written by pycal.calibration.study) and draws, per stage,
-the response of every evaluated point against its lab target and tolerance band, and
-the parameter history. Calibrated values are tabulated per material with the spread
-over seeds; provenance (config, seeds, YADE version, git commit) closes the page.
+Reads <study>/summary.json (pycal.calibration.outputs) and the stage plots. Laid out
+for a laptop screen: per material a table with one row per calibrated parameter group
+(named, e.g. "rolling resistance (M2, steel, PVC)"): estimate, 95 % interval,
+tolerance, runs and the stop reason; then per stage its calibration plot and lab
+curves. The headline counts a stage as met only when its 95 % interval lies within its
+tolerance. Provenance closes the page: git commit, the YADE versions that ran, seeds.
 """
 import base64
 import html
-import io
 import json
 import math
-import os
-import subprocess
 from pathlib import Path
 
-import matplotlib
+from .calibration.names import unit_label
+from .calibration.study import cost_per_material
+from .files import write_text
 
-matplotlib.use("Agg")
-import matplotlib.pyplot as plt  # noqa: E402
-
-from . import REPO_ROOT  # noqa: E402
-from .calibration.study import row_values, cost_per_material  # noqa: E402
-
-
-def _png_b64(fig):
-    buf = io.BytesIO()
-    fig.savefig(buf, format="png", dpi=110, bbox_inches="tight")
-    plt.close(fig)
-    return base64.b64encode(buf.getvalue()).decode()
-
-
-def stage_figure(stage, history):
-    """Response per evaluation with the target band, and the parameter per evaluation."""
-    pts = [h for h in history if h["material"] == stage["material"] and h["stage"] == stage["stage"]]
-    if not pts:
-        return None
-    fig, (ax1, ax2) = plt.subplots(1, 2, figsize=(9, 3.2))
-    it = list(range(1, len(pts) + 1))
-    ax1.errorbar(it, [p["mean"] for p in pts], yerr=[p["std"] for p in pts], fmt="o-", capsize=3,
-                 label="simulation (mean +/- std over seeds)")
-    tgt, tol = stage.get("target"), stage.get("tolerance")
-    if isinstance(tgt, (int, float)) and not math.isnan(tgt):
-        ax1.axhline(tgt, color="k", lw=1, label="lab target")
-        if isinstance(tol, (int, float)) and not math.isnan(tol):
-            ax1.axhspan(tgt - tol, tgt + tol, color="0.85", label="tolerance")
-    ax1.set_xlabel("evaluation")
-    ax1.set_ylabel(stage.get("response") or "response")
-    ax1.set_title(f"{stage['material']}: {stage['stage']}")
-    ax1.legend(fontsize=7)
-    for key in sorted({k for p in pts for k in p["parameters"] if not k.startswith("rig.")}):
-        label = key.replace("interactions.", "").replace("_coefficient", "")
-        ax2.plot(it, [p["parameters"].get(key, math.nan) for p in pts], "s-", label=label)
-    ax2.set_xlabel("evaluation")
-    ax2.set_ylabel("parameter value")
-    ax2.legend(fontsize=7)
-    fig.tight_layout()
-    return _png_b64(fig)
+CSS = """
+body{font-family:system-ui,sans-serif;max-width:1180px;margin:0 auto;padding:0 16px;color:#222;line-height:1.35}
+h1{font-size:22px}h2{font-size:18px;margin-top:28px;border-bottom:1px solid #ccc}h3{font-size:15px;margin-bottom:4px}
+table{border-collapse:collapse;width:100%;margin:6px 0 12px}
+td,th{border:1px solid #ccc;padding:3px 6px;font-size:13px;text-align:left;vertical-align:top}
+th{background:#f2f2f2}td.num{text-align:right;white-space:nowrap}tr.mat td{background:#e8eef6;font-weight:bold}
+.no{color:#b00;font-weight:bold}.yes{color:#070;font-weight:bold}.muted{color:#666;font-size:12px}
+img{max-width:100%;height:auto;border:1px solid #eee}details{margin:8px 0}pre{font-size:11px;overflow-x:auto}
+"""
 
 
-def _git_commit():
-    try:
-        return subprocess.run(["git", "-C", str(REPO_ROOT), "rev-parse", "HEAD"], capture_output=True,
-                              text=True, timeout=10).stdout.strip() or "unknown"
-    except Exception:
-        return "unknown"
+def _num(v, unit=""):
+    """A number for a table: 4 significant digits, its unit after it."""
+    if v is None or (isinstance(v, float) and not math.isfinite(v)):
+        return "-"
+    text = f"{v:.4g}".replace("e+0", "e").replace("e+", "e").replace("e-0", "e-")
+    u = unit_label(unit) if unit else ""
+    return text + (f" {u}" if u and u != "-" else "")
 
 
-def _fmt(v):
-    if isinstance(v, float):
-        return "" if math.isnan(v) else f"{v:.4g}"
+def _esc(v):
     return html.escape(str(v))
 
 
-def write_report(study_dir, yade_version="unknown"):
-    """Write <study_dir>/report.html; returns its path."""
+def _img(study_dir, rel):
+    data = base64.b64encode((study_dir / rel).read_bytes()).decode()
+    return f"<img alt='{_esc(rel)}' src='data:image/png;base64,{data}'>"
+
+
+def headline(stages):
+    """'3 of 5 calibrated stages met ...' and the stages not met (inherited values apart)."""
+    calibrated = [s for s in stages if s["kind"] != "inherit"]
+    met = [s for s in calibrated if s["met"]]
+    text = (f"{len(met)} of {len(calibrated)} calibrated stages met their tolerance "
+            f"(the whole 95 % interval within ± tolerance of the estimate).")
+    inherited = [s for s in stages if s["kind"] == "inherit"]
+    if inherited:
+        text += f" {len(inherited)} value{'s' if len(inherited) > 1 else ''} inherited from other materials."
+    return text, [s for s in calibrated if not s["met"]]
+
+
+def _stage_table(stages):
+    head = ("<table><tr><th>stage</th><th>parameter</th><th>estimate</th><th>95 % interval</th>"
+            "<th>tolerance</th><th>runs</th><th>verdict</th></tr>")
+    rows, material = [head], None
+    for s in stages:
+        if s["material"] != material:
+            material = s["material"]
+            rows.append(f"<tr class='mat'><td colspan='7'>{_esc(material)}</td></tr>")
+        verdict = (f"<span class='{'yes' if s['met'] else 'no'}'>{'met' if s['met'] else 'not met'}</span>"
+                   f"<br><span class='muted'>{_esc(s['stop_reason'])}</span>")
+        params = s["parameters"] or [None]
+        for i, p in enumerate(params):
+            cells = [_esc(s["stage"]) if i == 0 else ""]
+            if p is None:
+                cells += [f"<span class='muted'>{_esc(s.get('message', ''))}</span>", "-", "-", "-"]
+            else:
+                cells += [_esc(p["label"]), _num(p["estimate"], p["unit"]),
+                          f"{_num(p['low'])} - {_num(p['high'], p['unit'])}", "± " + _num(p["tolerance"], p["unit"])]
+            cells += [str(s.get("runs_requested", "")) if i == 0 else "", verdict if i == 0 else ""]
+            rows.append("<tr>" + "".join(f"<td{' class=num' if k in (2, 3, 4, 5) else ''}>{c}</td>"
+                                         for k, c in enumerate(cells)) + "</tr>")
+    rows.append("</table>")
+    return "\n".join(rows)
+
+
+def _stage_detail(study_dir, s):
+    parts = [f"<h3>{_esc(s['material'])}: {_esc(s['stage'])}</h3>"]
+    lines = []
+    for r in s.get("responses") or []:
+        if "at_estimate" not in r:
+            continue
+        unit = r.get("unit", "")
+        band = f", lab band ± {_num(r['band'], unit)}" if r.get("band") else ""
+        se = f", its standard error {_num(r['standard_error'], unit)}" if r.get("standard_error") else ""
+        lines.append(f"{_esc(r['response'])}: fitted mean at the estimate {_num(r['at_estimate'])} ± "
+                     f"{_num(1.96 * (r.get('at_estimate_sd') or 0), unit)} (95 %); target {_num(r['target'], unit)}"
+                     f"{band}{se} ({_esc(r.get('target_source', ''))}); seed noise sd {_num(r.get('noise_sd'), unit)}")
+    if s.get("correlation") and len(s["parameters"]) > 1:
+        names = [p["label"] for p in s["parameters"]]
+        pairs = [f"{names[i]} / {names[j]}: {s['correlation'][i][j]:+.2f}"
+                 for i in range(len(names)) for j in range(i + 1, len(names))]
+        lines.append("posterior correlation: " + "; ".join(_esc(p) for p in pairs))
+    lines.append(f"{s.get('points_count', 0)} points, {s.get('runs_requested', 0)} runs requested "
+                 f"({s.get('runs_simulated', 0)} simulated), {s.get('elapsed_s', 0):.0f} s; "
+                 f"{_esc(s['stop_reason'])}: {_esc(s.get('message', ''))}")
+    parts.append("<ul>" + "".join(f"<li>{line}</li>" for line in lines) + "</ul>")
+    for f in s.get("plots") or []:
+        if not (study_dir / f).is_file():
+            raise FileNotFoundError(f"{study_dir / f}: a plot named in summary.json is missing")
+        parts.append(_img(study_dir, f))
+    return "\n".join(parts)
+
+
+def _validation(study_dir, rows):
+    """The 'predicted' section: tests the calibration never saw, run with the calibrated values."""
+    if not rows:
+        return []
+    parts = ["<h2>Predicted (validation: nothing fitted to these tests)</h2>",
+             "<table><tr><th>prediction</th><th>response</th><th>predicted (mean +- SD, n)</th><th>lab +- band</th>"
+             "<th>z</th><th>verdict</th></tr>"]
+    for r in rows:
+        if r.get("error"):
+            parts.append(f"<tr><td>{_esc(r['prediction'])}</td><td colspan=5>runs failed: {_esc(r['error'])}</td></tr>")
+            continue
+        for c in r["comparisons"]:
+            lab = "-" if c["lab"] is None else f"{_num(c['lab'])} +- {_num(c['band'])}"
+            parts.append(f"<tr><td>{_esc(r['prediction'])} ({_esc(r['material'])}, {_esc(r['rig'])})</td>"
+                         f"<td>{_esc(c['response'])}</td><td class=num>{_num(c['sim_mean'])} +- {_num(c['sim_sd'])} "
+                         f"({c['n']})</td><td class=num>{lab}</td><td class=num>{_num(c['z'])}</td>"
+                         f"<td>{'inside the lab band' if c['inside'] else 'missed'}</td></tr>")
+    parts.append("</table>")
+    for r in rows:
+        if r.get("sensitivity"):
+            parts.append(f"<p>{_esc(r['prediction'])}: what drives the miss (each calibrated value moved, change of "
+                         f"{_esc(next(c['response'] for c in r['comparisons'] if not c['inside']))}):</p><ul>")
+            for x in r["sensitivity"][:6]:
+                change = "runs failed" if x["change"] is None else f"{x['change']:+.3g}"
+                parts.append(f"<li>{_esc(x['parameter'])} {_num(x['value'])} -> {_num(x['moved_to'])}: {change}</li>")
+            parts.append("</ul>")
+        if r.get("plot") and (study_dir / r["plot"]).is_file():
+            parts.append(_img(study_dir, r["plot"]))
+    return parts
+
+
+def write_report(study_dir):
+    """Write <study_dir>/report.html from summary.json and the plots; returns its path."""
     study_dir = Path(study_dir)
     summary = json.loads((study_dir / "summary.json").read_text())
-    stages, history = summary["stages"], summary["history"]
-    cfg = summary["study"]
-    met = sum(1 for s in stages if s["met"])
-    parts = [f"<!doctype html><html><head><meta charset='utf-8'><title>Calibration {html.escape(cfg['name'])}"
-             "</title><style>body{font-family:sans-serif;max-width:1000px;margin:auto}"
-             "table{border-collapse:collapse}td,th{border:1px solid #bbb;padding:3px 7px;font-size:13px}"
-             ".no{color:#b00;font-weight:bold}.yes{color:#070}</style></head><body>",
-             f"<h1>DEM calibration: {html.escape(cfg['name'])}</h1>",
-             f"<p>{html.escape(cfg.get('description', ''))}</p>",
-             f"<p><b>{met} of {len(stages)} stage targets met.</b> Runs requested: "
-             f"{summary['runs_requested']} (cached runs are not simulated again); "
-             f"elapsed {summary['elapsed_s']:.0f} s; {cfg['seeds_count']} seeds per point.</p>",
-             "<h2>Stages</h2><table><tr><th>material</th><th>stage</th><th>parameter</th><th>value</th>"
-             "<th>response</th><th>simulated (mean +/- std)</th><th>lab target</th><th>tolerance</th>"
-             "<th>met</th><th>note</th></tr>"]
-    for s in stages:
-        shown = dict(s, value="; ".join(f"{k} = {v:.4g}" for k, v in row_values(s).items())) if s.get("values") else s
-        parts.append("<tr>" + "".join(f"<td>{_fmt(shown.get(k, ''))}</td>" for k in
-                                      ("material", "stage", "parameter", "value", "response")) +
-                     f"<td>{_fmt(s['response_mean'])} +/- {_fmt(s['response_std'])}</td>"
-                     f"<td>{_fmt(s['target'])}</td><td>{_fmt(s['tolerance'])}</td>"
-                     f"<td class='{'yes' if s['met'] else 'no'}'>{'yes' if s['met'] else 'NO'}</td>"
-                     f"<td>{_fmt(s.get('message', ''))}</td></tr>")
-    parts.append("</table><h2>Cost per material</h2><p>Runs requested (cached ones included), runs simulated "
-                 "by YADE and wall time in the invocation that wrote this report.</p><table><tr><th>material</th>"
-                 "<th>runs requested</th><th>runs simulated</th><th>wall time s</th></tr>")
+    stages, cfg = summary["stages"], summary["study"]
+    text, not_met = headline(stages)
+    versions = ", ".join(summary.get("yade_versions") or []) or "not recorded in the results read"
+    parts = ["<!doctype html><html><head><meta charset='utf-8'>"
+             "<meta name='viewport' content='width=device-width, initial-scale=1'>"
+             f"<title>Calibration {_esc(cfg['name'])}</title><style>{CSS}</style></head><body>",
+             f"<h1>DEM calibration: {_esc(cfg['name'])}</h1>",
+             f"<p>{_esc(cfg.get('description', ''))}</p>",
+             f"<p><b>{_esc(text)}</b></p>"]
+    if not_met:
+        parts.append("<p>Not met: " + "; ".join(f"{_esc(s['material'])} {_esc(s['stage'])} "
+                                                 f"({_esc(s['stop_reason'])})" for s in not_met) + ".</p>")
+    parts.append(f"<p class='muted'>{summary['runs_requested']} runs requested (cached runs are not simulated "
+                 f"again), {summary['elapsed_s']:.0f} s; seeds from {summary['seed_base']}, "
+                 f"{len(summary['seeds'])} per new point; YADE {_esc(versions)}.</p>")
+    parts += ["<h2>Calibrated parameters</h2>", _stage_table(stages)]
+    parts.append("<h2>Cost per material</h2><table><tr><th>material</th><th>runs requested</th>"
+                 "<th>runs simulated</th><th>wall time s</th></tr>")
     for mat, c in cost_per_material(stages).items():
-        parts.append(f"<tr><td>{html.escape(mat)}</td><td>{c['runs_requested']}</td>"
-                     f"<td>{c['runs_simulated']}</td><td>{c['elapsed_s']:.0f}</td></tr>")
-    parts.append("</table><h2>Calibrated materials</h2>")
+        parts.append(f"<tr><td>{_esc(mat)}</td><td class=num>{c['runs_requested']}</td>"
+                     f"<td class=num>{c['runs_simulated']}</td><td class=num>{c['elapsed_s']:.0f}</td></tr>")
+    parts.append("</table><h2>Stages</h2>")
+    parts += [_stage_detail(study_dir, s) for s in stages if s["kind"] != "inherit"]
+    parts += _validation(study_dir, summary.get("predicted") or [])
+    parts.append("<h2>Calibrated material files</h2>")
     for mat, ov in summary["overrides"].items():
-        parts.append(f"<h3>{html.escape(mat)}</h3><p>file: calibrated/{html.escape(mat)}.yaml</p>"
-                     "<table><tr><th>config key</th><th>calibrated value</th></tr>")
+        iv = summary.get("intervals", {}).get(mat, {})
+        parts.append(f"<h3>{_esc(mat)}</h3><p class='muted'>calibrated/{_esc(mat)}.yaml</p>"
+                     "<table><tr><th>config key</th><th>value</th><th>95 % interval</th></tr>")
         for k, v in ov.items():
-            parts.append(f"<tr><td>{html.escape(k)}</td><td>{_fmt(v)}</td></tr>")
+            rng = iv.get(k)
+            shown = f"{_num(rng[1])} - {_num(rng[2])}" if rng else ""
+            parts.append(f"<tr><td>{_esc(k)}</td><td class=num>{_num(v) if isinstance(v, (int, float)) else _esc(v)}"
+                         f"</td><td class=num>{shown}</td></tr>")
         parts.append("</table>")
-    parts.append("<h2>Lab vs simulation per stage</h2>")
-    for s in stages:
-        img = stage_figure(s, history)
-        if img:
-            parts.append(f"<img alt='{html.escape(s['material'] + ' ' + s['stage'])}' "
-                         f"src='data:image/png;base64,{img}'>")
-    curves = [(s, f) for s in stages for f in s.get("plots") or [] if (study_dir / f).is_file()]
-    if curves:
-        parts.append("<h2>Lab curves vs simulation at the calibrated values</h2>")
-        for s, f in curves:
-            img = base64.b64encode((study_dir / f).read_bytes()).decode()
-            parts.append(f"<h4>{html.escape(s['material'] + ': ' + s['stage'])} ({html.escape(f)})</h4>"
-                         f"<img alt='{html.escape(f)}' style='max-width:100%' src='data:image/png;base64,{img}'>")
     parts.append("<h2>Provenance</h2><ul>"
-                 f"<li>study config: <pre>{html.escape(json.dumps(cfg, indent=1))}</pre></li>"
-                 f"<li>git commit: {html.escape(_git_commit())}</li>"
-                 f"<li>YADE version: {html.escape(yade_version)}</li>"
-                 "<li>every run's result.json (under the runs directory) holds its job, seed, YADE "
-                 "version and git commit</li></ul></body></html>")
-    path = study_dir / "report.html"
-    tmp = Path(str(path) + ".part")
-    tmp.write_text("\n".join(parts))
-    os.replace(tmp, path)
-    return path
+                 f"<li>git commit: {_esc(summary.get('git_commit', 'unknown'))}</li>"
+                 f"<li>YADE version of the runs: {_esc(versions)}</li>"
+                 f"<li>study config: {_esc(summary.get('config_file', ''))}; seeds {summary['seed_base']}, "
+                 f"{summary['seed_base'] + 1}, ... (--seed-base)</li>"
+                 "<li>every run's result.json (under the runs directory) holds its job, seed, YADE version and git "
+                 "commit; runs.csv lists every run of the study</li></ul>"
+                 f"<details><summary>study config</summary><pre>{_esc(json.dumps(cfg, indent=1))}</pre></details>"
+                 "</body></html>")
+    return write_text(study_dir / "report.html", "\n".join(parts))

@@ -14,3 +14,26 @@ LOG_FILE = "yade.log"
 EXIT_OK = 0
 EXIT_RIG_FAILURE = 3        # the rig refused the run: same job and seed fail the same way (kept as a verdict)
 EXIT_ERROR = 4              # a bug or a crash: not a verdict, the job runs again
+
+# ---------------------------------------------------------------- batch jobs (replicas)
+# A batch job holds the seeds of one rig point under BATCH_SEEDS_KEY instead of `seed`; the
+# rig runs one replica per seed in one scene (yade_scripts/demlib/replicas.py) and writes
+# ONE result.json for the batch, with a `replicas` list (one entry per seed: measurements
+# or the failure). pycal.replicas makes batch jobs and expands their results per seed.
+BATCH_SEEDS_KEY = "seeds"
+LAYOUT_KEY = "replica_layout"       # side_by_side (one scene) | sequential (one scene after the other)
+
+
+def replica_dir_name(seed):
+    """Folder of one replica's files inside the batch's job folder."""
+    return f"s{seed}"
+
+
+def seed_job(batch_job, seed):
+    """The job one replica of a batch runs: the batch job with `seed` instead of the seed
+    list, and its own job_id '<batch job_id>-s<seed>' (a replica's numbers are not a lone
+    run's: they depend on the batch)."""
+    job = {k: v for k, v in batch_job.items() if k not in (BATCH_SEEDS_KEY, LAYOUT_KEY, "job_id")}
+    job["seed"] = seed
+    job["job_id"] = f"{batch_job['job_id']}-s{seed}"
+    return job

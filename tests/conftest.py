@@ -20,7 +20,8 @@ def pytest_configure(config):
 
 
 def pytest_collection_finish(session):
-    from pycal.runner import YADE
+    from pycal.runner import yade_executable
+    YADE = yade_executable()
     physics = [item for item in session.items if item.get_closest_marker("yade")]
     if physics and shutil.which(YADE) is None:
         raise pytest.UsageError(

@@ -6,14 +6,14 @@ bottom edge is lift_clearance_m above the highest particle top, remove it, settl
 pile to rest and measure the four sector angles (pycal/post/aor.py documents the
 method). Particles that roll off the table are erased (n_fallen_off).
 Outputs: pile_particles.csv, pile_profile.csv, pile_side.png, result.json.
+A batch job (several seeds) builds one rig per seed side by side (demlib.replicas).
 Run: yade -j1 -x -n yade_scripts/aor.py job.json
 """
 import os
 import sys
 
 from yade_scripts.demlib.jobio import run_rig
-from yade_scripts.demlib.scene import Scene
-from yade_scripts.demlib import rigs
+from yade_scripts.demlib import rigs, replicas
 
 
 def pile_result(scene, out_dir, info, prefix="aor", files="pile", title="AoR"):
@@ -26,11 +26,13 @@ def pile_result(scene, out_dir, info, prefix="aor", files="pile", title="AoR"):
     return out
 
 
-def main(job, out_dir):
-    scene = Scene(job)
-    info, _ = rigs.cylinder_lift_pile(scene)
+def procedure(scene, out_dir):
+    """The pile of one seed (a generator: demlib.phases); returns the measurements."""
+    info, _ = yield from rigs.cylinder_lift_pile(scene)
     return pile_result(scene, out_dir, info)
 
+
+main = replicas.rig_main(procedure, half_width_m=rigs.table_half_width)
 
 if __name__ == "__main__" and os.path.basename(sys.argv[0]) == "aor.py":
     run_rig(main)

@@ -16,23 +16,25 @@ import os
 import sys
 
 from yade_scripts.demlib.jobio import run_rig, write_csv
-from yade_scripts.demlib import mixed, rigs
+from yade_scripts.demlib import mixed, rigs, replicas
 
 
 def build_pile(scene):
-    """Fill by mass, lift, settle (demlib.rigs.cylinder_lift_pile). Returns the entries of
+    """Phase: fill by mass, lift, settle (demlib.rigs.cylinder_lift_pile). Returns the entries of
     result.json about the run: the fill's masses and fractions, timings and counts."""
-    pile, cell = rigs.cylinder_lift_pile(scene, mixed.fill_cell_mixed)
+    pile, cell = yield from rigs.cylinder_lift_pile(scene, mixed.fill_cell_mixed)
     info = {k: v for k, v in cell.items() if k not in ("cylinder_ids", "table_ids", "settle_time_s", "steps")}
     info.update(pile)
     info["n_clumps_in_pile"] = len(scene.clumps)
     return info
 
 
-def main(job, out_dir):
+def procedure(scene, out_dir):
+    """The mixed pile (a generator: demlib.phases); lone jobs only: the time step comes from
+    the lumps drawn, so replicas would share the smallest of their batch (no replicas)."""
     from pycal.post import aor as aor_post, aor_mixed as post
-    scene = mixed.MixedScene(job)
-    info = build_pile(scene)
+    job = scene.job
+    info = yield from build_pile(scene)
     rows = scene.particle_rows()
     write_csv(out_dir, "pile_particles.csv", ["x_m", "y_m", "z_m", "radius_m", "material", "clump_id"], rows)
     whole, upper = post.measure(rows, scene.rig["measure"])
@@ -49,6 +51,8 @@ def main(job, out_dir):
     out.update(info)
     return out
 
+
+main = replicas.rig_main(procedure, scene_class=mixed.MixedScene)
 
 if __name__ == "__main__" and os.path.basename(sys.argv[0]) == "aor_mixed.py":
     run_rig(main)

@@ -14,18 +14,21 @@ step_tolerance_ratio of the target and the bulk is at rest, and record the step.
   (plate + weight - bottom - wall) / (plate + weight);
 - stiffness = secant d stress / d strain between steps (first from zero).
 Outputs: result.json (per-step arrays), spring_curve.csv, lab_comparison.csv, PNGs.
+A batch job (several seeds) builds one rig per seed side by side (demlib.replicas).
 Run: yade -j1 -x -n yade_scripts/ccs.py job.json
 """
 
 from yade_scripts.demlib.jobio import run_rig
-from yade_scripts.demlib import compression
+from yade_scripts.demlib import compression, replicas, rigs
 
 
-def main(job, out_dir):
-    scene, cell, plate, rec, extra = compression.confined_setup(job)
+def procedure(scene, out_dir):
+    """The load steps of one seed (a generator: demlib.phases)."""
+    cell, plate, rec, extra = yield from compression.confined_setup(scene)
     for target in scene.rig["procedure"]["load_steps_pa"]:
-        rec.step(target, "loading")
-    return compression.finish(job, out_dir, scene, rec, extra)
+        yield from rec.step(target, "loading")
+    return compression.finish(scene.job, out_dir, scene, rec, extra)
 
 
+main = replicas.rig_main(procedure, half_width_m=rigs.table_half_width)
 run_rig(main)

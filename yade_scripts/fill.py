@@ -2,18 +2,19 @@
 
 Bulk density = mass of the particles left after striking / cell volume (pi D^2/4 x H):
 particles whose centre is above the rim are removed (configs/rigs/fill.yaml).
+A batch job (several seeds) fills one cell per seed side by side (demlib.replicas).
 Run: yade -j1 -x -n yade_scripts/fill.py job.json
 """
 import math
 
 from yade_scripts.demlib.jobio import run_rig
-from yade_scripts.demlib.scene import Scene
-from yade_scripts.demlib import rigs
+from yade_scripts.demlib import rigs, replicas
 
 
-def main(job, out_dir):
-    scene = Scene(job)
-    cell = rigs.fill_cell(scene)
+def procedure(scene, out_dir):
+    """The fill of one seed (a generator: demlib.phases); returns the measurements."""
+    job = scene.job
+    cell = yield from rigs.fill_cell(scene)
     g = scene.rig["geometry"]
     volume = math.pi * g["cell_inner_diameter_m"] ** 2 / 4.0 * g["cell_height_m"]
     mass = scene.particle_mass_total()
@@ -34,4 +35,5 @@ def main(job, out_dir):
     }
 
 
+main = replicas.rig_main(procedure, half_width_m=rigs.table_half_width)
 run_rig(main)

@@ -5,25 +5,26 @@ then the table facets move kinematically on an ellipse (x = A_h sin wt,
 z = A_v (1 - cos wt), 90 degree phase) at vibration_frequency_hz for
 vibration_duration_s, stop at their home position, the pile settles and is measured
 again (surcharge_* keys, surcharge_*.csv, surcharge_side.png).
+A batch job (several seeds) builds one rig per seed side by side (demlib.replicas).
 Run: yade -j1 -x -n yade_scripts/surcharge.py job.json
 """
 
 from yade_scripts.demlib.jobio import run_rig
-from yade_scripts.demlib.scene import Scene
-from yade_scripts.demlib import rigs
+from yade_scripts.demlib import rigs, replicas
 from yade_scripts import aor
 
 
-def main(job, out_dir):
+def procedure(scene, out_dir):
+    """Pile, vibration and pile again of one seed (a generator: demlib.phases)."""
     from yade import O
-    scene = Scene(job)
+    job = scene.job
     p = scene.rig["procedure"]
-    info, cell = rigs.cylinder_lift_pile(scene)
+    info, cell = yield from rigs.cylinder_lift_pile(scene)
     out = aor.pile_result(scene, out_dir, info)
-    vib = rigs.vibrate_table(scene, cell["table_ids"], p["vibration_frequency_hz"],
-                             p["vibration_amplitude_horizontal_m"], p["vibration_amplitude_vertical_m"],
-                             p["vibration_duration_s"])
-    t_settle, n_fallen = rigs.settle_pile(scene, "surcharge settle")
+    vib = yield from rigs.vibrate_table(scene, cell["table_ids"], p["vibration_frequency_hz"],
+                                        p["vibration_amplitude_horizontal_m"], p["vibration_amplitude_vertical_m"],
+                                        p["vibration_duration_s"])
+    t_settle, n_fallen = yield from rigs.settle_pile(scene, "surcharge settle")
     keys, m = rigs.measure_pile(scene, out_dir, prefix="surcharge", files="surcharge",
                                 title=f"surcharge {scene.material} seed {job['seed']}")
     out.update(keys)
@@ -35,4 +36,5 @@ def main(job, out_dir):
     return out
 
 
+main = replicas.rig_main(procedure, half_width_m=rigs.table_half_width)
 run_rig(main)

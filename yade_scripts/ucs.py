@@ -20,21 +20,22 @@ servoed through procedure.load_steps_pa (demlib.loading, same rule as CCS).
   (load_stopped_at_pa, load_stop_reason, load_steps_completed_count); the curve holds
   the steps reached. A failure before the first step is still an error.
 Outputs: result.json (per-step arrays), spring_curve.csv, lab_comparison.csv, PNGs.
+A batch job (several seeds) builds one rig per seed side by side (demlib.replicas).
 Run: yade -j1 -x -n yade_scripts/ucs.py job.json
 """
 import math
 
 from yade_scripts.demlib.jobio import run_rig, OverlapLimitExceeded
-from yade_scripts.demlib.scene import Scene
-from yade_scripts.demlib import rigs, loading, compression
+from yade_scripts.demlib import rigs, loading, compression, replicas
 
 PLATE_SEGMENTS = 32   # polygon of the circular plate (equal area: the stress area is exact)
 
 
-def main(job, out_dir):
-    scene = Scene(job)
+def procedure(scene, out_dir):
+    """Pile and load steps of one seed (a generator: demlib.phases)."""
+    job = scene.job
     g, p = scene.rig["geometry"], scene.rig["procedure"]
-    pile, cell = rigs.cylinder_lift_pile(scene)
+    pile, cell = yield from rigs.cylinder_lift_pile(scene)
     d = g["plate_diameter_m"]
     area = math.pi * d * d / 4.0
     h0 = compression.top_of_bulk(scene)
@@ -47,9 +48,11 @@ def main(job, out_dir):
     def erase_fallen(t):
         fallen[0] += rigs.remove_fallen(scene, -2.0 * scene.radius)
 
+    ox, oy = scene.origin[0], scene.origin[1]
+
     def mass_in_volume(z):
         m = sum(b.state.mass for b in scene.live_spheres()
-                if math.hypot(b.state.pos[0], b.state.pos[1]) <= d / 2.0)
+                if math.hypot(b.state.pos[0] - ox, b.state.pos[1] - oy) <= d / 2.0)
         return m, area * z
 
     rec = compression.StepRecorder(scene, plate, h0, cell["table_ids"], [], mass_in_volume,
@@ -58,7 +61,7 @@ def main(job, out_dir):
     stop = {"load_stopped_at_pa": None, "load_stop_reason": None}
     for target in p["load_steps_pa"]:
         try:
-            rec.step(target, "loading")
+            yield from rec.step(target, "loading")
         except OverlapLimitExceeded as exc:
             # the few plate contacts of a free pile exceed the contact law's overlap range
             # before this stress: the curve ends at the last step reached (stated in result.json)
@@ -78,4 +81,5 @@ def main(job, out_dir):
     return compression.finish(job, out_dir, scene, rec, extra)
 
 
+main = replicas.rig_main(procedure, half_width_m=rigs.table_half_width)
 run_rig(main)

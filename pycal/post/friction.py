@@ -171,6 +171,42 @@ def friction_offset(result, quantity="mu_static", min_stress_pa=10000.0, targets
     return sum(diffs) / len(diffs)
 
 
+STICKS_ANGLE_DEG = 90.0   # a cell that does not slide up to the max tilt (lab or simulation)
+
+
+def friction_angle_offset_deg(result, quantity="mu_static", min_stress_pa=10000.0, targets=None):
+    """Mean over the simulated steps at or above min_stress_pa of (simulated - lab) tilt
+    angle atan(mu) in deg, where a step that sticks (lab or simulation) counts as 90 deg:
+    continuous through the lab cell's hang-on (the wet fines from ~60 kPa), rises with
+    cohesion. The lab angles are interpolated in log(stress) (sticking steps included)
+    at the simulated stress; simulated stresses outside the lab range are left out."""
+    from .compression import interp_log_stress
+    t = _lab_target(result, quantity, targets)
+    sim = compared_values(result, quantity)
+    lab_s, lab_a = [], []
+    for i, s in enumerate(t["stress_pa"]):
+        v = t["value"][i]
+        if t["outcome"][i] == "sticks":
+            lab_s.append(s)
+            lab_a.append(STICKS_ANGLE_DEG)
+        elif v is not None:
+            lab_s.append(s)
+            lab_a.append(math.degrees(math.atan(v)))
+    diffs = []
+    for k, s in enumerate(result["stress_pa"]):
+        if s < min_stress_pa:
+            continue
+        lab = interp_log_stress(lab_s, lab_a, s, extrapolate_ratio=0.0)
+        if lab is None:
+            continue
+        stuck = result["sticks"][k] or sim[k] >= STICKS_MU
+        diffs.append((STICKS_ANGLE_DEG if stuck else math.degrees(math.atan(sim[k]))) - lab)
+    if not diffs:
+        raise ValueError(f"{result.get('job_id', result.get('rig'))}: no simulated step at or above "
+                         f"{min_stress_pa:g} Pa inside the lab curve's stress range")
+    return sum(diffs) / len(diffs)
+
+
 def friction_band_z(result, quantity="mu_static", min_stress_pa=10000.0, targets=None):
     """Per lab step at or above min_stress_pa where the lab cell slides: z = (simulated -
     lab) / (half band width on the side of the simulation), the simulated curve

@@ -1,5 +1,6 @@
 """Fixtures of the unit layer."""
 import shutil
+import stat
 
 import pytest
 
@@ -12,3 +13,31 @@ def cfg(tmp_path):
     dst = tmp_path / "configs"
     shutil.copytree(CONFIG_DIR, dst)
     return dst
+
+
+FAKE_YADE = """#!/bin/sh
+# fake yade: args are -j1 -x -n SCRIPT JOB; behaviour chosen by $FAKE_MODE
+job="$5"
+echo "fake yade running $4 $job"
+echo run >> "$FAKE_COUNT"
+case "$FAKE_MODE" in
+  ok) echo '{"bulk_density_kg_m3": 1600.0, "n_particles": 100}' > result.json ;;
+  fail) echo "RIG FAILED: blow-up: particle 7 left the rig domain"; exit 3 ;;
+  refuse) echo "RIG FAILED: pile settle: no rest after 8 s" | tee rig_failure.txt; exit 3 ;;
+  partial) echo '{"bulk' > result.json.part; exit 4 ;;
+  sleep) sleep 5 ;;
+esac
+"""
+
+
+@pytest.fixture
+def fake_yade(tmp_path, monkeypatch):
+    exe = tmp_path / "fake-yade"
+    exe.write_text(FAKE_YADE)
+    exe.chmod(exe.stat().st_mode | stat.S_IEXEC)
+    monkeypatch.setenv("PYCAL_YADE", str(exe))
+    count = tmp_path / "count"
+    count.write_text("")
+    monkeypatch.setenv("FAKE_COUNT", str(count))
+    monkeypatch.setenv("FAKE_MODE", "ok")
+    return lambda: len(count.read_text().split())

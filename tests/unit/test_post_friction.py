@@ -123,3 +123,24 @@ def test_dynamic_friction_timed_near_vertical_is_not_a_value():
     s = friction.seed_summary([r])
     assert s["mu_dynamic_mean"] == [0.45, None] and s["mu_dynamic_n"] == [1, 0]
     assert friction.dynamic_value(r, 1) is None and friction.dynamic_value(r, 0) == 0.45
+
+
+def test_friction_angle_offset_counts_hanging_on_as_90_deg_on_both_sides():
+    """The wet fines' lab cell slides up to 40 kPa and hangs on from 60 kPa: a simulated
+    cell that slides at 86 kPa is 90 deg - atan(mu) short there; one that hangs on is not."""
+    t = {"mu_static": friction.targets_from_arrays([12000, 40000, 60000, 86000], [0.56, 0.70, float("nan"),
+                                                                                  float("nan")],
+                                                   [0.43, 0.5, float("nan"), float("nan")],
+                                                   [0.72, 1.0, float("nan"), float("nan")])}
+    stress = (3000, 12000, 40000, 86000)
+    sliding = result(1, [0.9, 0.56, 0.70, 0.80], [0.5] * 4, stress=stress)
+    expected = (0.0 + 0.0 + (90.0 - math.degrees(math.atan(0.80)))) / 3 * -1
+    assert friction.friction_angle_offset_deg(sliding, targets=t) == pytest.approx(expected)
+    hangs = result(1, [0.9, 0.56, 0.70, None], [0.5] * 4, sticks=[False, False, False, True], stress=stress)
+    assert friction.friction_angle_offset_deg(hangs, targets=t) == pytest.approx(0.0)
+    # between the last sliding lab step (40 kPa, 35 deg) and the first that hangs on (60 kPa,
+    # 90 deg) the lab angle is interpolated in log(stress): more cohesion keeps raising it
+    at_50 = result(1, [0.70], [0.5], stress=(50000,))
+    lab_50 = 35.0 + (90.0 - 35.0) * math.log(50000 / 40000) / math.log(60000 / 40000)
+    assert friction.friction_angle_offset_deg(at_50, targets=t) == pytest.approx(
+        math.degrees(math.atan(0.70)) - lab_50, abs=0.05)

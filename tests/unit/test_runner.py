@@ -1,10 +1,8 @@
 """Runner: caching, atomic completion, failures, yade-batch tables, CLI errors.
 
-A fake `yade` (a small script) stands in for YADE so this layer runs in seconds.
+A fake `yade` (conftest.py: fake_yade) stands in for YADE so this layer runs in seconds.
 """
 import json
-import os
-import stat
 
 import pytest
 
@@ -12,33 +10,6 @@ from pycal import runner
 from pycal.cli import main
 from pycal.errors import RunError
 from pycal.jobs import resolve_job
-
-FAKE_YADE = """#!/bin/sh
-# fake yade: args are -j1 -x -n SCRIPT JOB; behaviour chosen by $FAKE_MODE
-job="$5"
-echo "fake yade running $4 $job"
-echo run >> "$FAKE_COUNT"
-case "$FAKE_MODE" in
-  ok) echo '{"bulk_density_kg_m3": 1600.0, "n_particles": 100}' > result.json ;;
-  fail) echo "RIG FAILED: blow-up: particle 7 left the rig domain"; exit 3 ;;
-  refuse) echo "RIG FAILED: pile settle: no rest after 8 s" | tee rig_failure.txt; exit 3 ;;
-  partial) echo '{"bulk' > result.json.part; exit 4 ;;
-  sleep) sleep 5 ;;
-esac
-"""
-
-
-@pytest.fixture
-def fake_yade(tmp_path, monkeypatch):
-    exe = tmp_path / "fake-yade"
-    exe.write_text(FAKE_YADE)
-    exe.chmod(exe.stat().st_mode | stat.S_IEXEC)
-    monkeypatch.setattr(runner, "YADE", str(exe))
-    count = tmp_path / "count"
-    count.write_text("")
-    monkeypatch.setenv("FAKE_COUNT", str(count))
-    monkeypatch.setenv("FAKE_MODE", "ok")
-    return lambda: len(count.read_text().split())
 
 
 def test_run_once_then_cached(tmp_path, fake_yade):
@@ -131,7 +102,8 @@ def test_batch_table(tmp_path):
     table = tmp_path / "t.table"
     runner.write_batch_table(table, [("a", tmp_path / "a.json"), ("b", tmp_path / "b.json")])
     lines = table.read_text().splitlines()
-    assert lines[0] == "description jobFile" and lines[1].startswith("a /")
+    # yade-batch evaluates each value as Python: the path is a quoted absolute path
+    assert lines[0] == "description jobFile" and lines[1] == f"a '{tmp_path / 'a.json'}'"
 
 
 def test_cli_bad_material_one_line_exit_2(tmp_path, capsys):
@@ -151,6 +123,6 @@ def test_cli_bad_override_exit_2(tmp_path, capsys):
 
 
 def test_cli_run_with_fake_yade(tmp_path, fake_yade, capsys):
-    rc = main(["run", "fill", "--material", "M2", "--seeds", "2", "--out", str(tmp_path / "runs")])
+    rc = main(["run", "fill", "--material", "M2", "--seeds", "2", "--replicas", "1", "--out", str(tmp_path / "runs")])
     out = capsys.readouterr().out
     assert rc == 0 and "bulk_density_kg_m3=1600" in out and "over 2 seeds" in out

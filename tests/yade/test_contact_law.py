@@ -77,6 +77,20 @@ def test_rolling_stop_distance_on_a_wall_and_on_a_sphere(tmp_path):
     assert m["anvil_distance_m"] == pytest.approx(rolling_stop_distance(v0, 0.2), rel=0.05)
 
 
+def test_a_1_mm_particle_rolls_to_the_law_too(tmp_path):
+    """The rolling and twisting springs scale with k_t R^2: a 1 mm particle is as stable at
+    its time step as a 25 mm one and stops at the law's distance (v0 0.1 m/s, mu_r 0.1)."""
+    v0 = 0.1
+    job = scene_job({"particles.diameter_m": 0.001, "interactions.steel.friction_coefficient": 1.0,
+                     "interactions.steel.rolling_resistance_coefficient": 0.1})
+    add_material(job, "anvil", "M2", {})
+    m = run_scene(tmp_path, "roll", job, {"anvil_radius_m": 10.0, "anvil_start_arc_m": 0.005,
+                                          "launch_speed_m_s": v0, "damping": "config", "max_time_s": 0.5})
+    assert m["radius_m"] == 0.0005
+    assert m["max_slip_speed_m_s"] < 0.01 * v0
+    assert m["table_distance_m"] == pytest.approx(rolling_stop_distance(v0, 0.1), rel=0.05)
+
+
 @pytest.mark.parametrize("mu", [0.3, 0.5])
 @pytest.mark.parametrize("dtan", [-0.03, 0.03])
 def test_sliding_onset_at_tan_equal_mu(tmp_path, mu, dtan):

@@ -43,12 +43,12 @@ def test_fill_mass_is_count_times_particle_mass(fill_pair):
 
 
 def test_time_step_is_the_one_estimated_before_the_run(fill_pair):
-    """YADE's time step (0.3 x PWaveTimeStep) is what pycal.step_estimate computed from the
-    job alone: 0.3 x 0.0125 m / sqrt(6e6 Pa / 2750 kg/m3) = 8.028e-5 s."""
+    """YADE's time step (0.5 x PWaveTimeStep) is what pycal.step_estimate computed from the
+    job alone: 0.5 x 0.0125 m / sqrt(2e7 Pa / 2750 kg/m3) = 7.329e-5 s."""
     from pycal.step_estimate import critical_timestep
     job, res, _ = fill_pair
     assert res["timestep_s"] == pytest.approx(critical_timestep(job)[0], rel=1e-9)
-    assert res["timestep_s"] == pytest.approx(8.028e-5, rel=1e-3)
+    assert res["timestep_s"] == pytest.approx(7.329e-5, rel=1e-3)
 
 
 def test_fill_is_bit_reproducible(fill_pair):

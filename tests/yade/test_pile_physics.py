@@ -21,7 +21,8 @@ FAST = {"rig.procedure.lift_speed_m_s": 0.05,      # 25 x the lab speed: a ~2 s 
 # - frictionless spheres spread into a flat monolayer: no sector had an angle (the old
 #   rule read that as 0.0 deg) -> no angle, or below 5 deg, and at most two layers high;
 # - rolling 0.35 vs 0.02 (exactly 0 cannot come to rest, see the test): measured mean
-#   25.7 vs 6.2 deg (left 34 vs 7, right 24 vs 14) -> margin 10 deg.
+#   45.7 deg vs no angle in any sector (the heap spread to one layer) on the default law
+#   (first law: 25.7 vs 6.2 deg) -> 0.02 has no angle or one at least 10 deg lower.
 FRICTIONLESS_MAX_DEG = 5.0
 ROLLING_MARGIN_DEG = 10.0
 NO_ROLL = 0.02
@@ -65,8 +66,11 @@ def test_angle_rises_with_rolling_resistance(tmp_path_factory, base):
     # 0.02 is "practically none" and lets the spheres stop within a few cm
     no_roll = run(tmp_path_factory, "noroll", partners("rolling_resistance_coefficient", NO_ROLL))
     print("rolling 0.35:", {k: base[k] for k in ANGLES}, "rolling 0:", {k: no_roll[k] for k in ANGLES})
-    assert base["aor_mean_deg"] > no_roll["aor_mean_deg"] + ROLLING_MARGIN_DEG, \
+    assert base["aor_mean_deg"] is not None                 # rolling 0.35 stands as a pile
+    # nearly free rolling spreads the heap: a lower angle, or no flank left to measure (null)
+    assert no_roll["aor_mean_deg"] is None or base["aor_mean_deg"] > no_roll["aor_mean_deg"] + ROLLING_MARGIN_DEG, \
         (base["aor_mean_deg"], no_roll["aor_mean_deg"])
+    assert no_roll["pile_height_m"] < base["pile_height_m"]
 
 
 def test_same_seed_is_bit_identical(tmp_path_factory, base):

@@ -8,7 +8,6 @@ import os
 from yade import O
 
 from . import loading, rigs
-from .scene import Scene
 from .jobio import RigFailure
 
 from pycal.post import compression as post  # pure Python, no YADE
@@ -20,8 +19,8 @@ def vertical_force(ids):
 
 
 def max_overlap(scene):
-    """Largest overlap (penetration depth, m) of any real contact."""
-    return max((i.geom.penetrationDepth for i in O.interactions if i.isReal), default=0.0)
+    """Largest overlap (penetration depth, m) of any real contact of the scene."""
+    return max((i.geom.penetrationDepth for i in scene.interactions()), default=0.0)
 
 
 def top_of_bulk(scene):
@@ -51,7 +50,8 @@ class StepRecorder:
         self.data = {k: [] for k in self.FIELDS}
 
     def step(self, target, branch):
-        rec = loading.load_to(self.scene, self.plate, target, self.tol, every=self.every)
+        """Phase: load (or unload) to `target` (Pa) and record the step. Returns its row."""
+        rec = yield from loading.load_to(self.scene, self.plate, target, self.tol, every=self.every)
         z = self.plate.position_m()
         mass, volume = self.mass_in_volume(z)
         rho_b = mass / volume
@@ -98,11 +98,10 @@ def finish(job, out_dir, scene, recorder, extra):
     return m
 
 
-def confined_setup(job):
-    """Fill the cell and put the servo plate (a square lid covering the cell) on it.
-    Returns (scene, cell, plate, recorder, extra result entries)."""
-    scene = Scene(job)
-    cell = rigs.fill_cell(scene)
+def confined_setup(scene):
+    """Phase: fill the cell and put the servo plate (a square lid covering the cell) on it.
+    Returns (cell, plate, recorder, extra result entries)."""
+    cell = yield from rigs.fill_cell(scene)
     g, p = scene.rig["geometry"], scene.rig["procedure"]
     d = g["cell_inner_diameter_m"]
     area = math.pi * d * d / 4.0
@@ -120,4 +119,4 @@ def confined_setup(job):
              "timestep_s": cell["timestep_s"],
              "initial_bulk_density_kg_m3": scene.particle_mass_total() / (area * h0),
              "strain_reference": "h0 = highest particle top before loading (plate first-contact height)"}
-    return scene, cell, plate, rec, extra
+    return cell, plate, rec, extra

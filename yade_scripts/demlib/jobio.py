@@ -10,7 +10,6 @@ import datetime
 import json
 import os
 import platform
-import subprocess
 import sys
 import time
 import traceback
@@ -21,7 +20,8 @@ _JOB_DIR = None       # folder of the job file being run (load_job), where every
 
 
 from pycal.contact_rules import law_of_job
-from pycal.rig_contract import RESULT_FILE, RIG_FAILURE_FILE, EXIT_RIG_FAILURE, EXIT_ERROR, EXIT_OK
+from pycal.rig_contract import (RESULT_FILE, RIG_FAILURE_FILE, EXIT_RIG_FAILURE, EXIT_ERROR, EXIT_OK,
+                                BATCH_SEEDS_KEY)
 
 
 class RigFailure(Exception):
@@ -34,19 +34,34 @@ class OverlapLimitExceeded(RigFailure):
     early with a valid partial result (UCS loading) catch this one."""
 
 
+class JobFileError(Exception):
+    """The job file cannot be found or read (a usage error, not a rig failure)."""
+
+
+USAGE = "usage: yade -j1 -x -n yade_scripts/<rig>.py path/to/job.json (or a yade-batch table line with a jobFile column)"
+
+
 def job_path_from_argv():
-    """The job file: yade-batch's table column `jobFile`, else the first script argument."""
-    try:
+    """The job file: from yade-batch's table line (column `jobFile`) when YADE runs a
+    table line (YADE_BATCH is set), else the first script argument."""
+    batch_line = os.environ.get("YADE_BATCH", "")
+    if batch_line:
         from yade import utils
-        utils.readParamsFromTable(jobFile="", noTableOk=True)
+        try:
+            utils.readParamsFromTable(jobFile="", noTableOk=True)
+        except Exception as exc:       # YADE raises NameError, SyntaxError, RuntimeError, OSError...
+            raise JobFileError(f"yade-batch table line {batch_line}: cannot read it ({type(exc).__name__}: {exc}); "
+                               f"the table has the columns description and jobFile, jobFile a quoted path "
+                               f"such as '/abs/runs/fill/<job_id>/job.json'") from None
         from yade.params import table
-        if getattr(table, "jobFile", ""):
-            return table.jobFile
-    except Exception:
-        pass
+        path = getattr(table, "jobFile", "")
+        if not isinstance(path, str) or not path:
+            raise JobFileError(f"yade-batch table line {batch_line}: no jobFile column (or an empty one): "
+                               f"each line names its job file ('pycal batch-table' writes such tables)")
+        return path
     args = [a for a in sys.argv[1:] if not a.startswith("-")]
     if not args:
-        raise SystemExit("usage: yade -j1 -x -n yade_scripts/<rig>.py path/to/job.json")
+        raise JobFileError(USAGE)
     return args[0]
 
 
@@ -54,8 +69,15 @@ def load_job():
     """(job dict, output folder)."""
     global _JOB_DIR
     path = os.path.abspath(job_path_from_argv())
-    with open(path) as f:
-        job = json.load(f)
+    try:
+        with open(path) as f:
+            job = json.load(f)
+    except OSError as exc:
+        raise JobFileError(f"job file {path}: cannot read it ({exc.strerror})") from None
+    except ValueError as exc:
+        raise JobFileError(f"job file {path}: not valid JSON ({exc})") from None
+    if not isinstance(job, dict):
+        raise JobFileError(f"job file {path}: not a job (a JSON object is expected)")
     _JOB_DIR = os.path.dirname(path)
     return job, _JOB_DIR
 
@@ -64,16 +86,6 @@ def job_folder():
     """The folder of the job being run (the current directory if no job file was loaded:
     test scenes)."""
     return _JOB_DIR or os.getcwd()
-
-
-def _git(*args):
-    from pycal import REPO_ROOT
-    repo = str(REPO_ROOT)
-    try:
-        return subprocess.run(["git", "-C", repo] + list(args), capture_output=True, text=True,
-                              timeout=10).stdout.strip()
-    except Exception:
-        return ""
 
 
 def provenance():
@@ -88,8 +100,8 @@ def provenance():
         threads, simulated_time, steps = O.numThreads, O.time, O.iter
     except Exception:
         threads = simulated_time = steps = None
-    commit = _git("rev-parse", "HEAD") or "unknown"
-    dirty = bool(_git("status", "--porcelain", "--untracked-files=no"))
+    from pycal.gitinfo import git_commit, git_dirty
+    commit, dirty = git_commit(), git_dirty()
     return {
         "yade_version": yade_version,
         "git_commit": commit,
@@ -126,10 +138,12 @@ def write_csv(out_dir, name, columns, rows):
 
 
 def write_result(out_dir, job, measurements):
-    """result.json = measurements + the contact law that made them + job + provenance. Call once, last."""
+    """result.json = measurements + the contact law that made them + job + provenance. Call once, last.
+    A batch job (seeds, demlib.replicas): `seeds` instead of `seed`, the measurements hold `replicas`."""
     result = dict(measurements)
-    result.update({"job_id": job.get("job_id"), "rig": job["rig"], "material": job["material"],
-                   "seed": job["seed"], "contact_model": law_of_job(job), "job": job, "provenance": provenance()})
+    seed = {BATCH_SEEDS_KEY: job[BATCH_SEEDS_KEY]} if BATCH_SEEDS_KEY in job else {"seed": job["seed"]}
+    result.update({"job_id": job.get("job_id"), "rig": job["rig"], "material": job["material"], **seed,
+                   "contact_model": law_of_job(job), "job": job, "provenance": provenance()})
     text = json.dumps(result, indent=1, sort_keys=True, allow_nan=False)
     _atomic_write(os.path.join(out_dir, RESULT_FILE), text)
     print("RESULT written:", os.path.join(out_dir, RESULT_FILE), flush=True)
@@ -142,6 +156,10 @@ def run_rig(main):
     out_dir = None
     try:
         job, out_dir = load_job()
+    except JobFileError as exc:
+        print(f"RIG FAILED: {exc}", flush=True)
+        os._exit(EXIT_ERROR)
+    try:
         measurements = main(job, out_dir)
         from . import vtk_output
         snapshots = vtk_output.finish()

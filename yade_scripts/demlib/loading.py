@@ -24,19 +24,19 @@ API (kept stable; the friction rigs of issue 5 reuse it):
         plate.n_contacts()   particle contacts on the plate
         plate.set_target(stress_pa); plate.hold() (velocity 0, target dropped; without
                              a target the servo leaves the velocity as set by hand)
-        plate.run(seconds, every=None)   advance time with the servo active and the
+        plate.run(seconds, every=None)   phase: advance time with the servo active and the
                                          blow-up guards checked (scene.check + plate guards)
 
-    rec = load_to(scene, plate, stress_pa, tolerance_ratio, max_time_s=None, every=None)
-        Servo until |stress - target| <= tolerance_ratio x target AND the servo has
+    rec = yield from load_to(scene, plate, stress_pa, tolerance_ratio, max_time_s=None, every=None)
+        Phase: servo until |stress - target| <= tolerance_ratio x target AND the servo has
         stopped (inside half the tolerance) AND scene.is_at_rest(); then holds the plate
         still and returns {'stress_pa', 'force_n', 'position_m', 'time_s', 'steps',
         'contacts_count'}. every(t) as in plate.run. Raises RigFailure with a clear message when
         the stress is not reached at rest within max_time_s (default: the job's
         numerics.max_settle_time_s) or when the guards trip ('blow-up: ...').
 
-    rec = release(scene, plate, clearance_m, max_time_s=None)
-        Raise the plate until it has no contact and is `clearance_m` above the highest
+    rec = yield from release(scene, plate, clearance_m, max_time_s=None)
+        Phase: raise the plate until it has no contact and is `clearance_m` above the highest
         particle top, then settle the bulk under its own weight.
 
 Controller. err = F_target - F (N). The plate's stiffness as seen from the plate is
@@ -55,9 +55,9 @@ bulk: both raise RigFailure('blow-up: ...').
 Measured stress sits near the lower edge of the dead band (about -1 % of the target)
 because the plate approaches from below; the record holds the measured value.
 
-Stepping: O.step() in a Python loop. O.run(n, True) costs a fixed ~40 ms per call in
-YADE 2023.02a (it polls), which is 5-15x the compute of these small scenes when the
-servo must act every few steps.
+Stepping: the phases are generators (demlib.phases) that yield the steps to the next
+servo update; whoever drives them steps YADE with O.step() in a Python loop (O.run(n,
+True) costs a fixed ~40 ms per call in YADE 2023.02a: it polls).
 """
 import math
 
@@ -65,6 +65,7 @@ from yade import O, utils
 from yade import Vector3
 
 from .jobio import RigFailure
+from .phases import steps_of
 
 
 PLATE_FITS = ("circumscribed", "equal_area")
@@ -87,7 +88,7 @@ def strip_triangles(n):
 
 def add_plate(scene, z, diameter, material, segments=4, centre=(0.0, 0.0), fit="circumscribed"):
     """Horizontal rigid plate at height z (m): a regular polygon of `segments` corners
-    around `centre` (x, y in m), split into segments - 2 facets without an interior vertex.
+    around `centre` (x, y in m, relative to the scene's origin), split into segments - 2 facets without an interior vertex.
     fit='circumscribed': the polygon contains the whole circle of `diameter` (m), for a
     lid in a cell of that diameter (the corners stick out into the wall: harmless, facets
     never touch facets); the default square (2 facets) is the lid of the confined rigs.
@@ -111,7 +112,7 @@ def add_plate(scene, z, diameter, material, segments=4, centre=(0.0, 0.0), fit="
         r = radius / math.cos(math.pi / segments)
     else:
         r = radius * math.sqrt(2.0 * math.pi / (segments * math.sin(2.0 * math.pi / segments)))
-    cx, cy = centre
+    cx, cy = scene.origin[0] + centre[0], scene.origin[1] + centre[1]
     mat = scene.contact.mat_id[material]
     rim = [Vector3(cx + r * math.cos(2 * math.pi * k / segments),
                    cy + r * math.sin(2 * math.pi * k / segments), z) for k in range(segments)]
@@ -216,17 +217,22 @@ class ServoPlate:
 
     # ---------- time stepping ----------
     def run(self, seconds, every=None):
-        """Advance `seconds` of simulated time with the servo acting every control
+        """Phase: advance `seconds` of simulated time with the servo acting every control
         interval and the guards checked every numerics.rest_check_interval_s;
-        every(t) is called at each guard check if given."""
+        every(t) is called at each guard check if given. (Steps k = 0, 1, ...: the servo
+        acts before step k when k % ctrl == 0, the guards after it when (k + 1) % chk == 0.)"""
         steps = int(math.ceil(seconds / O.dt))
-        ctrl = max(1, int(round(self.control_interval_s / O.dt)))
-        chk = max(1, int(round(self.scene.num["rest_check_interval_s"] / O.dt)))
-        for k in range(steps):
+        ctrl = steps_of(self.control_interval_s, O.dt)
+        chk = steps_of(self.scene.num["rest_check_interval_s"], O.dt)
+        k = 0
+        while k < steps:
             if k % ctrl == 0:
                 self.control()
-            O.step()
-            if (k + 1) % chk == 0:
+            # run up to the next servo update or guard check, whichever comes first
+            n = min((k // ctrl + 1) * ctrl, (k // chk + 1) * chk, steps) - k
+            yield n
+            k += n
+            if k % chk == 0:
                 self.scene.check()
                 self.check()
                 if every is not None:
@@ -246,7 +252,7 @@ def load_to(scene, plate, stress_pa, tolerance_ratio, max_time_s=None, every=Non
     interval = scene.num["rest_check_interval_s"]
     plate.set_target(stress_pa, deadband_ratio=0.5 * tolerance_ratio)
     while True:
-        plate.run(interval, every)
+        yield from plate.run(interval, every)
         s = plate.stress_pa()
         if (plate.velocity == 0.0 and abs(s - stress_pa) <= tolerance_ratio * stress_pa
                 and scene.is_at_rest()):
@@ -277,7 +283,7 @@ def release(scene, plate, clearance_m, max_time_s=None):
         if O.time - t0 > max_time_s:
             raise RigFailure(f"release: the plate is still in contact after {max_time_s:g} s")
         plate._set_velocity(plate.vmax)
-        plate.run(interval)
+        yield from plate.run(interval)
     plate.hold()
-    t_settle = scene.settle("release")
+    t_settle = yield from scene.settle("release")
     return {"position_m": plate.position_m(), "time_s": O.time - t0, "settle_time_s": t_settle}

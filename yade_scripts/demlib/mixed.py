@@ -253,6 +253,7 @@ def _scene_class():
                 if i not in gone:
                     O.bodies.erase(i)
                     gone.add(i)
+            self.world.erased_count += 1
             self.free_ids = [i for i in self.free_ids if i not in gone]
             self.sphere_ids = [i for i in self.sphere_ids if i not in gone]
 
@@ -324,7 +325,7 @@ def MixedScene(job):
 
 
 def fill_cell_mixed(scene, gen=None):
-    """Table + PVC cylinder; generate and place the set's particles in a column inside
+    """Phase (a generator, demlib.phases): table + PVC cylinder; generate and place the set's particles in a column inside
     the cylinder, settle, strike (free spheres whose centre is above the strike level;
     M1 lumps stay), settle again. Returns the fill's entries for result.json and the
     cylinder/table ids."""
@@ -339,11 +340,11 @@ def fill_cell_mixed(scene, gen=None):
     scene.set_domain((-table_half, -table_half, -0.05), (table_half, table_half, column + 0.1))
     scene.add_placements(gen["placements"])
     generated = scene.component_masses()
-    dt = scene.set_timestep()
-    t1 = scene.settle("pour")
+    dt = yield scene.timestep()
+    t1 = yield from scene.settle("pour")
     above = [i for i in scene.free_ids if O.bodies[i].state.pos[2] > p["strike_level_height_m"]]
     scene.remove_spheres(above)
-    t2 = scene.settle("strike")
+    t2 = yield from scene.settle("strike")
     final = scene.component_masses()
     total = sum(final.values())
     out = {"cylinder_ids": cyl, "table_ids": table, "settle_time_s": t1 + t2, "timestep_s": dt,

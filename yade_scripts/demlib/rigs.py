@@ -1,25 +1,37 @@
-"""Building blocks shared by several rigs (runs inside YADE)."""
+"""Building blocks shared by several rigs (runs inside YADE).
+
+The phases (fill_cell, lift_cylinder, settle_pile, vibrate_table, cylinder_lift_pile) are
+generators (demlib.phases): `yield from` them in a rig procedure, or drive() them in a
+lone scene.
+"""
 from yade import O
 
 from .jobio import write_csv
+from .phases import steps_of
+
+
+def table_half_width(geometry):
+    """Half width (m) of the square table under the cell: table_radius_m, else the cell's
+    inner diameter (the rig's box reaches that far from the axis)."""
+    return geometry.get("table_radius_m", geometry["cell_inner_diameter_m"])
 
 
 def fill_cell(scene):
-    """Table + PVC cylinder; pour, settle, strike level at the rim, settle again.
+    """Phase: table + PVC cylinder; pour, settle, strike level at the rim, settle again.
     Returns {'cylinder_ids', 'table_ids', 'settle_time_s', 'steps', 'timestep_s'}."""
     g, p = scene.rig["geometry"], scene.rig["procedure"]
     d, h = g["cell_inner_diameter_m"], g["cell_height_m"]
-    table_half = g.get("table_radius_m", d)
+    table_half = table_half_width(g)
     table = scene.add_table(table_half, g["table_material"])
     column = p["pour_height_factor"] * h
     cyl = scene.add_cylinder(d, column + 2 * scene.radius, g["cell_facet_segments_count"], g["cell_material"])
     scene.set_domain((-table_half, -table_half, -0.05), (table_half, table_half, column + 0.1))
     scene.pour_cloud(d, 0.0, column, p["pour_porosity_ratio"])
-    dt = scene.set_timestep()
-    t1 = scene.settle("pour")
-    above = [b.id for b in scene.live_spheres() if b.state.pos[2] > p["strike_level_height_m"]]
+    dt = yield scene.timestep()
+    t1 = yield from scene.settle("pour")
+    above = [b.id for b in scene.live_spheres() if b.state.pos[2] - scene.origin[2] > p["strike_level_height_m"]]
     scene.remove_spheres(above)
-    t2 = scene.settle("strike")
+    t2 = yield from scene.settle("strike")
     return {"cylinder_ids": cyl, "table_ids": table, "settle_time_s": t1 + t2,
             "steps": O.iter, "timestep_s": dt}
 
@@ -32,7 +44,7 @@ def write_positions(scene, out_dir, name):
 # ---------- cylinder lift, pile measurement, table vibration (rigs aor, surcharge) ----------
 
 def highest_top(scene):
-    """Highest particle top z + r (m)."""
+    """Highest particle top z + r (m, world)."""
     return max(b.state.pos[2] + b.shape.radius for b in scene.live_spheres())
 
 
@@ -54,7 +66,7 @@ def remove_fallen(scene, below_z):
 
 
 def lift_cylinder(scene, cyl_ids, speed, clearance, bottom_z=0.0, table_z=0.0):
-    """Lift the cylinder facets at `speed` (m/s) in chunks of the rest-check interval
+    """Phase: lift the cylinder facets at `speed` (m/s) in chunks of the rest-check interval
     (particles that fell off the table erased, then the guards checked, each chunk) until the cylinder's bottom edge is `clearance` (m)
     above the highest particle top; then stop the facets (velocity zeroed: kinematic
     bodies keep their velocity) and erase them. Returns {'lift_time_s', 'lift_height_m',
@@ -69,9 +81,9 @@ def lift_cylinder(scene, cyl_ids, speed, clearance, bottom_z=0.0, table_z=0.0):
     interval = scene.num["rest_check_interval_s"]
     fallen = 0
     set_velocity(cyl_ids, (0, 0, speed))
-    steps = max(1, int(round(interval / O.dt)))
+    steps = steps_of(interval, O.dt)
     while True:
-        scene.advance(steps)
+        yield steps
         fallen += remove_fallen(scene, table_z - 2.0 * scene.radius)
         scene.check()
         if not scene.live_spheres():
@@ -90,16 +102,16 @@ def lift_cylinder(scene, cyl_ids, speed, clearance, bottom_z=0.0, table_z=0.0):
 
 
 def settle_pile(scene, what, table_z=0.0):
-    """Scene.settle's loop (same rest criterion, guards and time limit), but particles
+    """Phase: Scene.settle's loop (same rest criterion, guards and time limit), but particles
     that rolled off the table are erased at every check before the guards see them
     (a frictionless sphere slides for ever: Cundall damping does not act on a zero net
     force). Returns (settle time s, number erased)."""
     from .jobio import RigFailure
     t0 = O.time
-    chunk = max(1, int(round(scene.num["rest_check_interval_s"] / O.dt)))
+    chunk = steps_of(scene.num["rest_check_interval_s"], O.dt)
     fallen = 0
     while True:
-        scene.advance(chunk)
+        yield chunk
         fallen += remove_fallen(scene, table_z - 2.0 * scene.radius)
         if not scene.live_spheres():
             raise RigFailure(f"{what}: every particle fell off the table")
@@ -113,7 +125,7 @@ def settle_pile(scene, what, table_z=0.0):
 
 
 def vibrate_table(scene, table_ids, frequency, amp_x, amp_z, duration, updates_per_period=20):
-    """Kinematic elliptical vibration of the table facets (no dynamics of the table):
+    """Phase: kinematic elliptical vibration of the table facets (no dynamics of the table):
     displacement x = amp_x sin(w t), z = amp_z (1 - cos(w t)) (90 degree phase, starts
     at rest position), w = 2 pi frequency, for `duration` s. Velocity is set
     `updates_per_period` times per period so that each chunk ends exactly on the
@@ -124,9 +136,9 @@ def vibrate_table(scene, table_ids, frequency, amp_x, amp_z, duration, updates_p
     from yade import Vector3
     w = 2.0 * math.pi * frequency
     home = {i: Vector3(O.bodies[i].state.pos) for i in table_ids}
-    n = max(1, int(round(1.0 / (frequency * updates_per_period) / O.dt)))
+    n = steps_of(1.0 / (frequency * updates_per_period), O.dt)
     total = int(math.ceil(duration / O.dt))
-    check = max(1, int(round(scene.num["rest_check_interval_s"] / O.dt)))
+    check = steps_of(scene.num["rest_check_interval_s"], O.dt)
     t0, done, next_check, fallen = O.time, 0, check, 0
     while done < total:
         k = min(n, total - done)
@@ -135,7 +147,7 @@ def vibrate_table(scene, table_ids, frequency, amp_x, amp_z, duration, updates_p
         for i in table_ids:
             s = O.bodies[i].state
             s.vel = (home[i] + off - s.pos) / (k * O.dt)
-        scene.advance(k)
+        yield k
         done += k
         if done >= next_check:
             fallen += remove_fallen(scene, -2.0 * scene.radius)
@@ -165,14 +177,15 @@ def measure_pile(scene, out_dir, prefix="aor", files="pile", title=None):
 
 
 def cylinder_lift_pile(scene, fill=fill_cell):
-    """The cylinder-lift pile of the AoR rigs: fill(scene) (default fill_cell: pour,
+    """Phase: the cylinder-lift pile of the AoR rigs: fill(scene) (default fill_cell: pour,
     settle, strike), lift the cylinder at procedure.lift_speed_m_s until it is
     lift_clearance_m above the highest particle top, erase it, settle the pile.
     Returns (the timing and count entries of result.json, the fill's dict)."""
     p = scene.rig["procedure"]
-    cell = fill(scene)
-    lift = lift_cylinder(scene, cell["cylinder_ids"], p["lift_speed_m_s"], p["lift_clearance_m"])
-    t_settle, n_fallen = settle_pile(scene, "pile settle")
+    cell = yield from fill(scene)
+    lift = yield from lift_cylinder(scene, cell["cylinder_ids"], p["lift_speed_m_s"], p["lift_clearance_m"],
+                                    bottom_z=scene.origin[2], table_z=scene.origin[2])
+    t_settle, n_fallen = yield from settle_pile(scene, "pile settle", table_z=scene.origin[2])
     return {
         "lift_time_s": lift["lift_time_s"],
         "lift_height_m": lift["lift_height_m"],

@@ -15,6 +15,7 @@ import os
 from yade import O
 
 from .jobio import RigFailure
+from .phases import drive
 from .tilt_bodies import Lid, add_rigid_cell, force_sum
 from .tilt_test import Tilt, tilt_test
 
@@ -53,13 +54,13 @@ def pour_and_strike(scene, diameter, z_bottom, cell_top, pour_height, porosity, 
         funnel = list(scene.add_cylinder(diameter, funnel_h, funnel_segments, funnel_material, z0=cell_top))
     scene.pour_cloud(diameter, z_bottom, pour_height, porosity)
     scene.set_timestep()
-    t1 = scene.settle("pour")
+    t1 = drive(scene.settle("pour"))
     print(f"poured: {len(scene.live_spheres())} particles settled in {t1:.2f} s", flush=True)
     above = [b.id for b in scene.live_spheres() if b.state.pos[2] > strike_level]
     scene.remove_spheres(above)
     for i in funnel:
         O.bodies.erase(i)
-    t2 = scene.settle("strike")
+    t2 = drive(scene.settle("strike"))
     return t1 + t2
 
 
@@ -88,7 +89,7 @@ def consolidate(scene, lid, cell, plate_ids, stress_pa, area, proc, curve, step_
                       -force_sum(plate_ids)[2] if plate_ids else None))
 
     print(f"step {step_index}: loading to {stress_pa:.0f} Pa (t={O.time:.2f} s)", flush=True)
-    rec = load_to(scene, servo, stress_pa, proc["step_tolerance_ratio"], every=record)
+    rec = drive(load_to(scene, servo, stress_pa, proc["step_tolerance_ratio"], every=record))
     record()
     out = {"stress_reached_pa": rec["stress_pa"], "lid_z_loaded_m": rec["position_m"],
            "lid_force_loaded_n": rec["force_n"],
@@ -96,11 +97,11 @@ def consolidate(scene, lid, cell, plate_ids, stress_pa, area, proc, curve, step_
            "load_time_s": rec["time_s"]}
     w = lid.mass * scene.g / area
     print(f"step {step_index}: unloading to the lid weight {w:.0f} Pa (t={O.time:.2f} s)", flush=True)
-    load_to(scene, servo, w, proc["step_tolerance_ratio"], every=record)
+    drive(load_to(scene, servo, w, proc["step_tolerance_ratio"], every=record))
     record()
     servo.hold()
     lid.make_rigid()
-    scene.settle(f"unloaded after {stress_pa:.0f} Pa")
+    drive(scene.settle(f"unloaded after {stress_pa:.0f} Pa"))
     out["lid_z_unloaded_m"] = lid.z()
     return out
 
@@ -111,7 +112,7 @@ STEP_KEYS = ("mu_static", "mu_dynamic", "sticks", "max_tilt_deg", "onset_angle_d
              "plate_force_ratio_onset", "plate_force_ratio_sliding", "slid_distance_m",
              "cell_gap_start_m", "cell_gap_min_m", "tilt_time_s", "lid_z_loaded_m", "lid_z_unloaded_m",
              "plate_force_loaded_n", "lid_force_loaded_n", "stress_reached_pa", "load_time_s",
-             "spilled_particles_count", "drift_before_tilt_m",
+             "spilled_particles_count", "drift_before_tilt_m", "pre_tilt_end_deg",
              "wall_time_step_s")
 RECORD_KEYS = ("stress_pa",) + STEP_KEYS          # columns of friction.csv, per-step arrays of result.json
 SPRING_COLUMNS = ["step_index_count", "time_s", "lid_stress_pa", "lid_position_m", "lid_force_n", "plate_force_n"]

@@ -8,8 +8,9 @@ tilt_test() runs the phases in order:
 1. free the cell: the lid is joined to it (one rigid body hanging on the contents) and
    it translates freely (rotations blocked); with procedure.settle_before_tilt it first
    comes to rest at zero tilt (its drift is recorded, the slide is measured from there);
-2. static friction: tilt at tilt_rate_deg_s until the cell has slid
-   slide_onset_displacement_m (mu_static = tan of that angle);
+2. static friction: tilt (at pre_tilt_rate_deg_s until the cell has slid
+   pre_tilt_slide_fraction of the onset distance, then at the lab's tilt_rate_deg_s)
+   until the cell has slid slide_onset_displacement_m (mu_static = tan of that angle);
 3. dynamic friction: hold that angle and time the travel of dynamic_travel_distance_m
    (fit of x = v0 t + a t^2 / 2, mu_dynamic = tan t - a / (g cos t)); a stalled cell makes
    the tilt resume (at tilt_restart_rate_deg_s) to the next onset, where the hold is
@@ -22,6 +23,7 @@ from yade import O
 from yade import Vector3
 
 from .jobio import RigFailure
+from .phases import drive
 from .tilt_bodies import force_sum, join, set_damped, split, stop_all
 from pycal.post.friction import DYNAMIC_MAX_ANGLE_DEG  # pure Python: one rule for rig and post
 
@@ -106,24 +108,33 @@ def free_the_cell(scene, cell, lid, proc, step_index):
     # freed at zero tilt, the cell can drift while the unloaded contents relax (wet fines
     # after 60 kPa: 4.3 mm before 0.5 deg of tilt, measured); that is not sliding
     x_free, y_free = cell.pos[0], cell.pos[1]
-    scene.settle(f"cell freed before the tilt of step {step_index}")
+    drive(scene.settle(f"cell freed before the tilt of step {step_index}"))
     return math.hypot(cell.pos[0] - x_free, cell.pos[1] - y_free)
 
 
 def static_onset(run, proc):
-    """Tilt at tilt_rate_deg_s until the cell has slid slide_onset_displacement_m (the
-    angle interpolated at the crossing); at max_tilt_deg hold for dynamic_max_time_s to
-    see whether it starts. Returns ({'onset_angle_deg', 'plate_force_ratio_onset'},
-    the angle reached (deg)); onset_angle_deg None when the cell did not slide."""
+    """Tilt until the cell has slid slide_onset_displacement_m (the angle interpolated at
+    the crossing): at pre_tilt_rate_deg_s while the cell has slid less than
+    pre_tilt_slide_fraction x that distance (the contents barely strained: quasi-static
+    at either rate), then at the lab's tilt_rate_deg_s up to the onset (a pre-tilt rate
+    not above the lab rate: the lab rate from zero). At max_tilt_deg hold for
+    dynamic_max_time_s to see whether it starts. Returns ({'onset_angle_deg',
+    'plate_force_ratio_onset', 'pre_tilt_end_deg'}, the angle reached (deg));
+    onset_angle_deg None when the cell did not slide; pre_tilt_end_deg the angle where the
+    lab rate took over (None without a pre-tilt)."""
     rate, max_tilt = proc["tilt_rate_deg_s"], proc["max_tilt_deg"]
     onset_d, hold_max = proc["slide_onset_displacement_m"], proc["dynamic_max_time_s"]
-    angle = 0.0
+    pre_rate, pre_until = proc["pre_tilt_rate_deg_s"], proc["pre_tilt_slide_fraction"] * onset_d
+    pre = pre_rate > rate
+    angle, pre_end = 0.0, None
     onset_angle, onset_ratio = None, None
     x_prev, a_prev = 0.0, 0.0
     while True:
-        angle = min(max_tilt, angle + rate * run.dt_chunk)
+        angle = min(max_tilt, angle + (pre_rate if pre else rate) * run.dt_chunk)
         run.tilt.set(angle)
         x, f = run.chunk()
+        if pre and x >= pre_until:
+            pre, pre_end = False, angle
         if x >= onset_d:
             # interpolate the angle at which x crossed the threshold
             frac = (onset_d - x_prev) / (x - x_prev) if x > x_prev else 1.0
@@ -139,7 +150,7 @@ def static_onset(run, proc):
                 onset_angle, onset_ratio = angle, plate_ratio(f)
             break
         x_prev, a_prev = x, angle
-    return {"onset_angle_deg": onset_angle, "plate_force_ratio_onset": onset_ratio}, angle
+    return {"onset_angle_deg": onset_angle, "plate_force_ratio_onset": onset_ratio, "pre_tilt_end_deg": pre_end}, angle
 
 
 def _hold(run, travel_d, stall_s, hold_max, ratios):
@@ -216,7 +227,7 @@ def tilt_back(run, scene, cell, lid, proc):
         run.tilt.set(max(0.0, run.tilt.angle_deg - back * run.dt_chunk))
         run.chunk()
     run.spilled += remove_spilled(scene, run.spill_box)
-    scene.settle(f"tilt back after step {run.step_index}")
+    drive(scene.settle(f"tilt back after step {run.step_index}"))
 
 
 def tilt_test(scene, tilt, cell, lid, plate_ids, spill_box, proc, record, step_index, restore=True):

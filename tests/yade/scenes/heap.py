@@ -12,11 +12,12 @@ def main():
     job, p, out = _common.load()
     from yade_scripts.demlib.scene import Scene
     from yade_scripts.demlib import rigs
+    from yade_scripts.demlib.phases import drive
     sc = Scene(job)
-    cell = rigs.fill_cell(sc)
-    rigs.lift_cylinder(sc, cell["cylinder_ids"], sc.rig["procedure"]["lift_speed_m_s"],
-                       sc.rig["procedure"]["lift_clearance_m"])
-    t_settle, _ = rigs.settle_pile(sc, "pile settle")
+    cell = drive(rigs.fill_cell(sc))
+    drive(rigs.lift_cylinder(sc, cell["cylinder_ids"], sc.rig["procedure"]["lift_speed_m_s"],
+                             sc.rig["procedure"]["lift_clearance_m"]))
+    t_settle, _ = drive(rigs.settle_pile(sc, "pile settle"))
     start = {b.id: Vector3(b.state.pos) for b in sc.live_spheres()}
     sc.advance(int(round(p["creep_time_s"] / O.dt)))
     moved = max((O.bodies[i].state.pos - p0).norm() for i, p0 in start.items())

@@ -38,13 +38,14 @@ def rows(sc):
 def main():
     job, p, out = _common.load()
     from yade_scripts.demlib import rigs, mixed
+    from yade_scripts.demlib.phases import drive
     if "material_set" in job:
         sc = mixed.MixedScene(job)
-        mixed.fill_cell_mixed(sc)
+        drive(mixed.fill_cell_mixed(sc))
     else:
         from yade_scripts.demlib.scene import Scene
         sc = Scene(job)
-        rigs.fill_cell(sc)
+        drive(rigs.fill_cell(sc))
     first = rows(sc)
     sc.advance(int(round(p["extra_time_s"] / O.dt)) + sc.contact.hook_interval)
     _common.finish(out, {"contacts": first + rows(sc), "gravity_m_s2": sc.g, "iter": O.iter,

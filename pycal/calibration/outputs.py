@@ -1,0 +1,83 @@
+"""The study's output files in <out>/<study name>/, rewritten (atomically) after every stage.
+
+  calibrated/<material>.yaml  the material config with the calibrated values (loads as a config)
+  stages.csv    one row per calibrated parameter: estimate, 95 % interval, tolerance, met,
+                stop reason, runs requested/simulated, the response at the estimate vs its
+                target, the seed noise (parameter_unit / response_unit columns give the units)
+  history.csv   one row per point run: parameters, response mean, std and runs
+  runs.csv      one row per run: parameters, seed, response value
+  summary.json  all of the above plus the study config, seeds, YADE versions of the runs
+"""
+import json
+import math
+import time
+
+import yaml
+
+from .. import REPO_ROOT
+from ..files import finite, write_csv, write_json, write_text
+from ..gitinfo import git_commit
+
+STAGE_COLUMNS = ["material", "stage", "kind", "parameter", "parameter_unit", "keys", "estimate", "interval_low",
+                 "interval_high", "tolerance", "met", "stop_reason", "runs_requested", "runs_simulated",
+                 "points_count", "elapsed_s", "response", "response_unit", "target", "target_band",
+                 "response_at_estimate", "seed_noise_sd", "message"]
+POINT_COLUMNS = ["material", "stage", "rig", "parameters", "response", "mean", "std", "n", "seeds"]
+RUN_COLUMNS = ["material", "stage", "rig", "parameters", "seed", "response", "value"]
+
+
+def _cell(v):
+    if isinstance(v, float):
+        return "" if math.isnan(v) else f"{v:.6g}"
+    if isinstance(v, (list, dict)):
+        return json.dumps(v)
+    return "" if v is None else v
+
+
+def stage_table(rows):
+    """Rows of stages.csv: one per parameter (a stage without a value: one row)."""
+    out = []
+    for r in rows:
+        resp = r.get("responses") or [{}]
+        first = resp[0]
+        common = {"material": r["material"], "stage": r["stage"], "kind": r["kind"], "met": r["met"],
+                  "stop_reason": r["stop_reason"], "runs_requested": r.get("runs_requested"),
+                  "runs_simulated": r.get("runs_simulated"), "points_count": r.get("points_count"),
+                  "elapsed_s": r.get("elapsed_s"), "message": r.get("message", ""),
+                  "response": "; ".join(x.get("response", "") for x in resp),
+                  "response_unit": first.get("unit", ""), "target": first.get("target", math.nan),
+                  "target_band": first.get("band", math.nan),
+                  "response_at_estimate": first.get("at_estimate", math.nan),
+                  "seed_noise_sd": first.get("noise_sd", math.nan)}
+        for p in r["parameters"] or [None]:
+            row = dict(common)
+            if p:
+                row.update({"parameter": p["label"], "parameter_unit": p["unit"], "keys": " ".join(p["keys"]),
+                            "estimate": p["estimate"], "interval_low": p["low"], "interval_high": p["high"],
+                            "tolerance": p["tolerance"]})
+            out.append([_cell(row.get(c, "")) for c in STAGE_COLUMNS])
+    return out
+
+
+def write_all(study):
+    """Write every output file of the study as it stands."""
+    out = study.out
+    for m in study.cfg["materials"]:
+        write_text(out / "calibrated" / f"{m}.yaml", yaml.safe_dump(study.calibrated_material(m),
+                                                                         sort_keys=False))
+    write_csv(out / "stages.csv", STAGE_COLUMNS, stage_table(study.stage_rows))
+    write_csv(out / "history.csv", POINT_COLUMNS,
+                     [[_cell(p[c]) for c in POINT_COLUMNS] for p in study.points])
+    write_csv(out / "runs.csv", RUN_COLUMNS, [[_cell(r[c]) for c in RUN_COLUMNS] for r in study.runs])
+    summary = {"study": study.cfg["raw"], "config_file": str(study.config_path), "seeds": study.seeds,
+               "seed_base": study.seed_base,
+               # what the calibration fitted ("calibrated on") and what it predicts with those values
+               "calibrated_on": [{"material": r["material"], "stage": r["stage"], "kind": r["kind"],
+                                  "responses": [x.get("response") for x in r.get("responses", [])]}
+                                 for r in study.stage_rows if r["kind"] != "inherit"],
+               "predicted": getattr(study, "validation_rows", []),
+               "stages": study.stage_rows, "history": study.points,
+               "runs": study.runs, "overrides": study.overrides, "intervals": study.intervals,
+               "runs_requested": study.runs_requested, "elapsed_s": time.time() - study.t0,
+               "yade_versions": sorted(study.yade_versions), "git_commit": git_commit()}
+    write_json(out / "summary.json", finite(summary))

@@ -1,0 +1,185 @@
+"""A one-parameter stage (density, rolling_resistance, cohesion, stiffness, friction).
+
+1. the start point (seeds_count runs);
+2. a second point: a Newton step when physics gives the slope (density: the bulk
+   density is proportional to the particle density; a stated response_slope_estimate),
+   else a quarter of the bounds towards the target;
+3. then, until the stop rule (pycal.stats.stopping) says stop: fit the response model
+   to every run so far, invert it for the target (estimate, 95 % interval), and run
+   the point that most shrinks the interval (pycal.stats.sequential.step_1d).
+A point the rig refuses becomes a limit: the bounds in use end halfway between it and
+the nearest point that ran. The calibrated value is the estimate (4 significant digits).
+"""
+import math
+
+import numpy as np
+
+from ..errors import RunError
+from ..post import responses as responses_mod
+from ..stats import stopping
+from ..stats.scales import Scale, round_significant
+from ..stats.sequential import second_point_u, step_1d
+from . import plots
+from .names import unit_label
+from .study import BudgetSpent
+
+
+def _slope_per_u(st, scale, x0, y0):
+    """d response / d u at the start (u: the parameter on [0, 1]) when physics gives it, signed."""
+    p = st["parameter"]
+    span = (math.log(scale.hi) - math.log(scale.lo)) if scale.log else (scale.hi - scale.lo)
+    if st["kind"] == "density":
+        slope = y0 * span if scale.log else y0 / x0 * span      # bulk density proportional to particle density
+    elif p.get("slope"):
+        slope = p["slope"] * (x0 * span if scale.log else span)
+    else:
+        return None
+    return slope if p["increasing"] else -slope
+
+
+def run(study, material, st):
+    """Run the stage; returns its row (parameters, responses, met, stop reason, plots)."""
+    p = st["parameter"]
+    label = st["label"]
+    study.overrides[material].update(st["set"])
+    target = study.targets[(material, label)][0]
+    response = responses_mod.get(st["response"])
+    scale = Scale(*p["bounds"], log=p["scale"] == "log")
+    lab_dir = study.lab_dir(st)
+    n = len(study.seeds)
+    runs_at_start = study.runs_requested
+    xs, ys, refused = [], [], []
+    lo_u, hi_u = 0.0, 1.0
+
+    def runs_left():
+        return min(st["max_runs_count"] - (study.runs_requested - runs_at_start), study.runs_left())
+
+    def extra(x):
+        return {**st["rig_overrides"], **{k: x for k in p["keys"]}}
+
+    jr = study.stage_journal(material, st)
+
+    def point(x, replay=False):
+        """Run x; False when the rig refused it (then the bounds in use shrink)."""
+        nonlocal lo_u, hi_u
+        x = round_significant(x)
+        if not replay:
+            jr.record(x)
+        try:
+            vals = study.run_point(material, label, st["rig"], extra(x), response, lab_dir)
+        except RunError as exc:
+            if not xs:
+                raise                      # the start point itself: the stage cannot run
+            u, ran = float(scale.to_unit(x)), scale.to_unit(np.array(xs))
+            refused.append((x, str(exc)))
+            study.log(f"  the rig refused {p['label']} = {x:.4g}: it becomes a limit")
+            if u > np.median(ran):
+                hi_u = min(hi_u, 0.5 * (u + float(np.max(ran[ran < u], initial=0.0))))
+            else:
+                lo_u = max(lo_u, 0.5 * (u + float(np.min(ran[ran > u], initial=1.0))))
+            return False
+        xs.extend([x] * len(vals))
+        ys.extend(vals)
+        return True
+
+    def decide(runs):
+        return step_1d(scale, xs, ys, target.value, p["increasing"],
+                       tolerance=None if p["tolerance_is_percent"] else p["tolerance"],
+                       tolerance_percent=p["tolerance"] if p["tolerance_is_percent"] else None,
+                       standard_error=target.standard_error, band=target.band, runs_left=runs,
+                       runs_per_point=n, lo_u=lo_u, hi_u=hi_u)
+
+    while (x := jr.next_recorded()) is not None:        # a resumed study: the same points again
+        point(x, replay=True)
+    if jr.result and len(set(xs)) >= 2:
+        step = decide(0)
+        for k, v in jr.result.items():                    # the values carried before, exactly
+            setattr(step, k, v)
+        return _row(study, material, st, p, scale, xs, ys, step, target, response, refused, lo_u, hi_u, extra,
+                    lab_dir)
+    start = p["start"] if p["start"] is not None else min(max(study.current_value(material, p["keys"][0]),
+                                                              p["bounds"][0]), p["bounds"][1])
+    if not xs:
+        point(start)
+    x0 = round_significant(start)
+    y0 = float(np.mean([y for x, y in zip(xs, ys) if x == x0] or ys))
+    u0 = float(scale.to_unit(x0))
+    budget_note = ""
+    while len(set(xs)) < 2:
+        if runs_left() < n:
+            budget_note = "one point only"
+            break
+        u1 = second_point_u(u0, y0, target.value, p["increasing"], _slope_per_u(st, scale, x0, y0), lo_u, hi_u)
+        if abs(u1 - u0) < 1e-6:
+            u1 = 0.5 * (u0 + (hi_u if u0 < 0.5 else lo_u))
+        try:
+            point(float(scale.from_unit(u1)))
+        except BudgetSpent:
+            budget_note = "study run budget spent"
+            break
+    if len(set(xs)) < 2:
+        return _one_point_row(study, st, target, response, xs, ys, budget_note)
+    while True:
+        step = decide(runs_left())
+        if step.stop:
+            break
+        try:
+            point(step.next_x)
+        except BudgetSpent:
+            step = decide(0)
+            step.stop = stopping.STUDY_BUDGET
+            break
+    step.estimate = round_significant(step.estimate)
+    jr.finish({k: getattr(step, k) for k in ("estimate", "low", "high", "tolerance", "band_low", "band_high", "stop")})
+    return _row(study, material, st, p, scale, xs, ys, step, target, response, refused, lo_u, hi_u, extra, lab_dir)
+
+
+def _row(study, material, st, p, scale, xs, ys, step, target, response, refused, lo_u, hi_u, extra, lab_dir):
+    """The stage's row (and plots) from its runs and final step; carries the value on."""
+    value = step.estimate
+    study.set_value(material, p["keys"], value, (value, step.low, step.high))
+    mean, var = step.model.mean_var(np.array([[float(scale.to_unit(value))]]))
+    row = {
+        "parameters": [{"label": p["label"], "keys": p["keys"], "unit": p["unit"], "scale": p["scale"],
+                        "estimate": value, "low": step.low, "high": step.high, "tolerance": step.tolerance,
+                        "band_low": step.band_low, "band_high": step.band_high}],
+        "responses": [{"rig": st["rig"], "response": response.name, "unit": response.unit, "target": target.value,
+                       "band": target.band, "standard_error": target.standard_error,
+                       "target_source": target.source, "at_estimate": float(mean[0]),
+                       "at_estimate_sd": float(math.sqrt(var[0])), "noise_sd": step.model.noise_sd,
+                       "noise_dof": step.model.noise_dof}],
+        "met": step.stop == stopping.WITHIN, "stop_reason": step.stop,
+        "message": _message(step, p, scale, xs, ys, target, refused, lo_u, hi_u),
+        "points_count": len(set(xs)),
+    }
+    row["plots"] = plots.stage_1d(study, material, st, row, scale, xs, ys, step, target, response)
+    row["plots"] += plots.lab_curves(study, material, st["label"], st["rig"], extra(value), response, lab_dir)
+    return row
+
+
+def _message(step, p, scale, xs, ys, target, refused, lo_u, hi_u):
+    half = max(step.estimate - step.low, step.high - step.estimate)
+    unit = "" if unit_label(p["unit"]) == "-" else " " + unit_label(p["unit"])
+    msg = f"95 % interval within +-{half:.3g}{unit} of the estimate; tolerance +-{step.tolerance:.3g}{unit}"
+    if step.stop in (stopping.BEYOND_UPPER, stopping.BEYOND_LOWER):
+        at = float(scale.from_unit(hi_u if step.stop == stopping.BEYOND_UPPER else lo_u))
+        near = [y for x, y in zip(xs, ys) if abs(float(scale.to_unit(x)) - float(scale.to_unit(at))) < 0.01]
+        msg = (f"the target {target.value:.4g} lies beyond what {p['label']} = {at:.4g} reaches "
+               f"({np.mean(near):.4g} there, {len(near)} runs)")
+    if refused:
+        msg += "; the rig refused " + ", ".join(f"{x:.4g}" for x, _ in refused) + f" ({refused[0][1][:160]})"
+    return msg
+
+
+def _one_point_row(study, st, target, response, xs, ys, note):
+    p = st["parameter"]
+    return {"parameters": [{"label": p["label"], "keys": p["keys"], "unit": p["unit"], "scale": p["scale"],
+                            "estimate": math.nan, "low": math.nan, "high": math.nan,
+                            "tolerance": math.nan if p["tolerance_is_percent"] else p["tolerance"],
+                            "band_low": math.nan, "band_high": math.nan}],
+            "responses": [{"rig": st["rig"], "response": response.name, "unit": response.unit,
+                           "target": target.value, "band": target.band, "standard_error": target.standard_error,
+                           "target_source": target.source, "at_estimate": float(np.mean(ys)) if ys else math.nan}],
+            "met": False, "stop_reason": stopping.BUDGET,
+            "message": f"{note}: a response model needs two points (start {xs[0] if xs else '-'} only)",
+            "points_count": len(set(xs))}

@@ -1,0 +1,156 @@
+"""A joint stage: 2-3 coupled parameter groups against one or more responses.
+
+E.g. the wet wall friction (fines-steel friction sets the curve's level, the adhesion
+its rise with consolidation: one vector response, a band z per lab step), or the final
+pass over rolling resistance and particle density (AoR and bulk density: two rigs).
+
+1. the start point and one step per parameter (a tenth of its bounds, inwards): d + 1
+   points, each running every response's rig with seeds_count seeds;
+2. then, until the stop rule: a response model per output over all runs, the posterior
+   over the parameters sampled with emcee, and the point (drawn from the posterior)
+   that most shrinks the outputs' uncertainty where the posterior lies
+   (pycal.stats.sequential.step_nd).
+Reported per parameter: estimate (posterior median), 95 % interval, and the
+correlation matrix. A point the rig refuses is not asked again, nor anything closer to
+it than half its distance to the nearest point that ran (in u); a refused first step
+is tried the other way once.
+"""
+import math
+
+import numpy as np
+
+from ..errors import RunError
+from ..post import responses as responses_mod
+from ..stats import stopping
+from ..stats.scales import Scale, round_significant
+from ..stats.sequential import step_nd
+from . import plots
+from .names import unit_label
+from .study import BudgetSpent
+
+FIRST_STEP_U = 0.1      # a tenth of the bounds: a second pass starts from values already close
+
+
+def run(study, material, st):
+    """Run the stage; returns its row."""
+    label = st["label"]
+    params = st["parameters"]
+    study.overrides[material].update(st["set"])
+    tgts = study.targets[(material, label)]
+    resp = [responses_mod.get(r["response"]) for r in st["responses"]]
+    scales = [Scale(*p["bounds"], log=p["scale"] == "log") for p in params]
+    lab_dir = study.lab_dir(st)
+    n = len(study.seeds)
+    per_point = n * len(resp)
+    runs_at_start = study.runs_requested
+    X, Y, refused = [], [], []
+    widths = [None] * len(resp)          # outputs per response (a vector's length)
+
+    def runs_left():
+        return min(st["max_runs_count"] - (study.runs_requested - runs_at_start), study.runs_left())
+
+    def extra(xs, r):
+        e = dict(r["rig_overrides"])
+        for p, x in zip(params, xs):
+            e.update({k: x for k in p["keys"]})
+        return e
+
+    jr = study.stage_journal(material, st)
+
+    def point(xs, replay=False):
+        """Run xs; False when the rig refused it."""
+        xs = [round_significant(x) for x in xs]
+        if not replay:
+            jr.record(xs)
+        try:
+            cols = []
+            for j, (r, response) in enumerate(zip(st["responses"], resp)):
+                vals = study.run_point(material, label, r["rig"], extra(xs, r), response, lab_dir)
+                vals = [v if isinstance(v, list) else [v] for v in vals]
+                widths[j] = widths[j] or len(vals[0])
+                cols.append([[math.nan if v is None else float(v) for v in row] for row in vals])
+        except RunError as exc:
+            if not X:
+                raise
+            refused.append((xs, str(exc)))
+            study.log(f"  the rig refused {xs}: no point near it is asked again")
+            return False
+        for i in range(n):
+            X.append(xs)
+            Y.append([v for c in cols for v in c[i]])
+        return True
+
+    while (xs := jr.next_recorded()) is not None:        # a resumed study: the same points again
+        point(xs, replay=True)
+    x0 = [p["start"] if p["start"] is not None else
+          min(max(study.current_value(material, p["keys"][0]), p["bounds"][0]), p["bounds"][1]) for p in params]
+    if not X and not refused:
+        point(x0)
+    targets = [t.value for t, w in zip(tgts, widths) for _ in range(w)]       # one per output
+    ses = [t.standard_error for t, w in zip(tgts, widths) for _ in range(w)]
+    tols = [(p["tolerance"], p["tolerance_is_percent"]) for p in params]
+
+    def decide(runs):
+        return step_nd(scales, X, Y, targets, ses, tols, runs_left=runs, runs_per_point=per_point,
+                       avoid_x=[x for x, _ in refused])
+
+    if jr.result:
+        step = decide(0)
+        for k, v in jr.result.items():                    # the values carried before, exactly
+            setattr(step, k, v)
+    else:
+        u0 = [float(s.to_unit(x)) for s, x in zip(scales, x0)]
+        try:
+            for j in range(len(params)):
+                for sign in ((1, -1) if u0[j] <= 0.5 else (-1, 1)):     # refused: the other way once
+                    u = list(u0)
+                    u[j] = min(1.0, max(0.0, u[j] + sign * FIRST_STEP_U))
+                    xs = [round_significant(float(s.from_unit(v))) for s, v in zip(scales, u)]
+                    if xs in X:                           # run already (replayed)
+                        break
+                    if any(xs == r for r, _ in refused):  # refused already: the other way
+                        continue
+                    if point(xs):
+                        break
+            while True:
+                step = decide(runs_left())
+                if step.stop:
+                    break
+                point(step.next_x)
+        except BudgetSpent:
+            if len({tuple(x) for x in X}) < 2:
+                raise
+            step = decide(0)
+            step.stop = stopping.STUDY_BUDGET
+        step.estimate = [round_significant(v) for v in step.estimate]
+        jr.finish({k: getattr(step, k) for k in ("estimate", "low", "high", "tolerance", "correlation", "stop")})
+    values = list(step.estimate)
+    for p, v, lo, hi in zip(params, values, step.low, step.high):
+        study.set_value(material, p["keys"], v, (v, lo, hi))
+    u_est = np.array([[float(s.to_unit(v)) for s, v in zip(scales, values)]])
+    out_resp, k = [], 0
+    for r, response, t, w in zip(st["responses"], resp, tgts, widths):
+        for e in range(w):
+            m = step.models[k] if k < len(step.models) else None
+            mean, var = m.mean_var(u_est) if m else (np.array([math.nan]), np.array([math.nan]))
+            out_resp.append({"rig": r["rig"], "response": response.name + (f"[{e}]" if response.vector else ""),
+                             "unit": response.unit, "target": t.value, "band": t.band,
+                             "standard_error": t.standard_error, "target_source": t.source,
+                             "at_estimate": float(mean[0]), "at_estimate_sd": float(math.sqrt(var[0])),
+                             "noise_sd": m.noise_sd if m else math.nan, "noise_dof": m.noise_dof if m else 0})
+            k += 1
+    row = {"parameters": [{"label": p["label"], "keys": p["keys"], "unit": p["unit"], "scale": p["scale"],
+                           "estimate": v, "low": lo, "high": hi, "tolerance": tol,
+                           "band_low": math.nan, "band_high": math.nan}
+                          for p, v, lo, hi, tol in zip(params, values, step.low, step.high, step.tolerance)],
+           "responses": out_resp, "correlation": step.correlation, "met": step.stop == stopping.WITHIN,
+           "stop_reason": step.stop, "points_count": len({tuple(x) for x in X}),
+           "message": "; ".join(f"{p['label']}: 95 % interval within +-{max(v - lo, hi - v):.3g} "
+                                f"{unit_label(p['unit'])} (tolerance +-{tol:.3g})"
+                                for p, v, lo, hi, tol in zip(params, values, step.low, step.high, step.tolerance))
+           + (("; the rig refused " + ", ".join(str(x) for x, _ in refused)) if refused else "")}
+    row["plots"] = plots.stage_joint(study, material, st, row, scales, np.array(X), np.array(Y), step, tgts,
+                                     widths, resp)
+    for r, response in zip(st["responses"], resp):
+        row["plots"] += plots.lab_curves(study, material, label, r["rig"], extra(values, r), response, lab_dir)
+    return row

@@ -1,0 +1,283 @@
+"""The study config (configs/calibrations/*.yaml): validated and made explicit.
+
+Every error names the file, the dotted key and the reason (exit 2 from the CLI), and
+the whole file is checked before any run starts. `load_study` returns the config with
+each stage normalised: defaults filled in, so the driver reads one shape per kind.
+
+Stage kinds
+  density, rolling_resistance, cohesion, stiffness, friction   one parameter group, one response
+  joint      2-3 parameter groups, one or more responses (rigs): a posterior over them
+  inherit    copy a value (and its interval) found for another material
+
+A parameter group:
+  keys        config keys set to one value (e.g. rolling resistance on M2, steel, PVC)
+  bounds      [lo, hi] in the keys' unit
+  start       first point (default: the value the study has reached, inside the bounds)
+  scale       linear | log (default log for stiffness and density: they span a range of ratios)
+  tolerance_<unit> or tolerance_percent   the stop rule: the 95 % interval within +- this
+              of the estimate, in the parameter's unit (unit = the keys' suffix:
+              tolerance_coefficient, tolerance_pa, tolerance_kg_m3, tolerance_fraction)
+  response_increases         1-D stages: the direction physics gives the response (required)
+  response_slope_estimate    1-D stages, optional: |d response / d parameter| from physics
+A target: {value: X} | {sample: KEY, test: angle_of_repose} | {} (bulk density: the
+material's lab sample), with optional band_<unit> (the lab band: plotted, and the
+parameter range it allows) and standard_error_<unit> (the target is itself a mean,
+e.g. a twin's: widens the interval), <unit> = the response's unit.
+"""
+import copy
+from pathlib import Path
+
+from ..configs import _Checker, load_material, load_yaml
+from ..post import responses as responses_mod
+from .names import group_label, unit_of_key
+
+ONE_D = ("density", "rolling_resistance", "cohesion", "stiffness", "friction")
+KINDS = ONE_D + ("joint", "inherit")
+LOG_SCALE_KINDS = ("density", "stiffness")
+DENSITY_KEY = "particles.density_kg_m3"
+DEFAULT_POINTS_COUNT = 8          # a stage's default run budget: this many points' worth of runs
+
+REMOVED = {
+    "max_iterations_count": "replaced by max_runs_count (a run budget: every seed counts)",
+    "max_seeds_count": "no longer used: the design adds runs where they shrink the interval",
+    "tolerance_deg": "the lab band is now target.band_deg; the stop rule is parameter.tolerance_<unit>",
+    "tolerance_mu": "the lab band is now target.band_mu; the stop rule is parameter.tolerance_<unit>",
+    "tolerance_log_ratio": "the lab band is now target.band_log_ratio; the stop rule is parameter.tolerance_<unit>",
+    "tolerance_percent": "the lab band is now target.band_percent; the stop rule is parameter.tolerance_<unit>",
+    "tolerance_rms_z": "joint stages: responses[].target.band_z, and each parameter's tolerance_<unit>",
+}
+
+
+def stage_label(st):
+    """The name of a stage in outputs and `inherit`: its `name`, else its kind."""
+    return st.get("name", st["stage"])
+
+
+def _check_removed(c, data, key):
+    for k in data:
+        if k in REMOVED:
+            c.fail(f"{key}.{k}" if key else k, REMOVED[k])
+
+
+def _material_has(mat_cfg, dotted):
+    node = mat_cfg
+    for part in dotted.split("."):
+        if not isinstance(node, dict) or part not in node:
+            return False
+        node = node[part]
+    return True
+
+
+def _parameter(c, p, key, material, mat_cfg, kind, one_d):
+    """A validated, explicit parameter group."""
+    if not isinstance(p, dict):
+        c.fail(key, "must be a mapping (keys, bounds, tolerance_<unit>, ...)")
+    tol_keys = [k for k in p if k.startswith("tolerance_")]
+    optional = ["keys", "start", "scale", "label"] + (["response_increases", "response_slope_estimate"] if one_d else [])
+    c.keys(p, key, ["bounds"] + ([] if kind == "density" else ["keys"]), optional + tol_keys)
+    keys = p.get("keys", [DENSITY_KEY] if kind == "density" else None)
+    if not isinstance(keys, list) or not keys or not all(isinstance(k, str) for k in keys):
+        c.fail(f"{key}.keys", "must be a non-empty list of config keys")
+    for k in keys:
+        if not _material_has(mat_cfg, k):
+            c.fail(f"{key}.keys", f"{k}: no such key in configs/materials/{material}.yaml "
+                                  f"(with the stages' `set` so far)")
+    units = {unit_of_key(k) for k in keys}
+    if len(units) != 1 or None in units:
+        c.fail(f"{key}.keys", f"{keys}: all keys of a group need the same unit suffix")
+    unit = units.pop()
+    if len(tol_keys) != 1 or tol_keys[0] not in (f"tolerance_{unit}", "tolerance_percent"):
+        c.fail(f"{key}.tolerance_{unit}", f"give the stop rule's tolerance once, in the parameter's unit: "
+                                          f"tolerance_{unit} (or tolerance_percent of the estimate)"
+                                          + (f"; found {', '.join(tol_keys)}" if tol_keys else ""))
+    tol = c.number(p[tol_keys[0]], f"{key}.{tol_keys[0]}", 0, lo_open=True)
+    b = p["bounds"]
+    if not isinstance(b, list) or len(b) != 2:
+        c.fail(f"{key}.bounds", "must be [lo, hi]")
+    lo, hi = (c.number(v, f"{key}.bounds") for v in b)
+    if not lo < hi:
+        c.fail(f"{key}.bounds", f"{b}: need lo < hi")
+    scale = p.get("scale", "log" if kind in LOG_SCALE_KINDS else "linear")
+    c.string(scale, f"{key}.scale", ["linear", "log"])
+    if scale == "log" and lo <= 0:
+        c.fail(f"{key}.bounds", f"{b}: a log scale needs bounds > 0")
+    if "start" in p:
+        c.number(p["start"], f"{key}.start")
+        if not lo <= p["start"] <= hi:
+            c.fail(f"{key}.start", f"{p['start']} outside bounds {b}")
+    out = {"keys": list(keys), "bounds": [float(lo), float(hi)], "start": p.get("start"), "scale": scale,
+           "unit": unit, "tolerance": float(tol), "tolerance_is_percent": tol_keys[0] == "tolerance_percent",
+           "tolerance_key": tol_keys[0], "label": p.get("label") or group_label(keys)}
+    if one_d:
+        inc = p.get("response_increases", True if kind == "density" else None)
+        if not isinstance(inc, bool):
+            c.fail(f"{key}.response_increases", "must be true or false: the direction physics gives the "
+                                                "response (the noise must not decide)")
+        out["increasing"] = inc
+        slope = p.get("response_slope_estimate")
+        if slope is not None and not c.number(slope, f"{key}.response_slope_estimate") > 0:
+            c.fail(f"{key}.response_slope_estimate", f"{slope}: must be > 0 (|d response / d parameter|)")
+        out["slope"] = slope
+    return out
+
+
+def _target(c, t, key, response):
+    """A validated target spec (the value itself is read from the lab data by the study)."""
+    t = {} if t is None else t
+    if not isinstance(t, dict):
+        c.fail(key, "must be a mapping: {value: X} or {sample: KEY, test: NAME}, with optional band_<unit>")
+    unit = response.unit
+    allowed = ["value", "sample", "test", f"band_{unit}", "band_percent", f"standard_error_{unit}"]
+    for k in t:
+        if k not in allowed:
+            hint = (f" (this response is in {unit}: band_{unit}, standard_error_{unit})"
+                    if k.startswith(("band_", "standard_error_")) else "")
+            c.fail(f"{key}.{k}", f"unknown key{hint}; allowed: {', '.join(allowed)}")
+    has_lab = {"sample", "test"} <= set(t)
+    if "value" in t:
+        c.number(t["value"], f"{key}.value")
+        if "sample" in t or "test" in t:
+            c.fail(key, "give either value or sample + test, not both")
+    elif not has_lab and response.name != "bulk_density_kg_m3":
+        c.fail(key, f"needs value (or sample + test for an angle); only bulk_density_kg_m3 defaults to the "
+                    f"material's lab sample")
+    if has_lab and response.name not in ("aor_mean_deg",):
+        c.fail(f"{key}.sample", f"a lab sample's angle is a target of aor_mean_deg only, not {response.name}")
+    for k in (f"band_{unit}", "band_percent", f"standard_error_{unit}"):
+        if k in t:
+            c.number(t[k], f"{key}.{k}", 0)
+    if f"band_{unit}" in t and "band_percent" in t:
+        c.fail(f"{key}.band_percent", f"give band_{unit} or band_percent, not both")
+    if "band_percent" in t and "value" in t and t["value"] == 0:
+        c.fail(f"{key}.band_percent", "a band in percent of a zero target is zero: give band_" + unit)
+    return dict(t)
+
+
+def _response(c, name, key):
+    r = responses_mod.get(name) if isinstance(name, str) else None
+    if r is None:
+        c.fail(key, f"{name!r}: not a known response ({', '.join(responses_mod.RESPONSES)}) nor a result key "
+                    f"with a unit suffix")
+    return r
+
+
+def _check_overrides(c, st, key, material=None, mat_cfg=None):
+    """rig_overrides only rig keys; `set` only existing material keys (applied to mat_cfg,
+    the material as the study has changed it so far)."""
+    for k, v in (st.get("set", {}) or {}).items():
+        if str(k).startswith("rig."):
+            c.fail(f"{key}.set.{k}", "only material keys may be set here (rig keys: rig_overrides)")
+        if mat_cfg is not None:
+            if not _material_has(mat_cfg, k):
+                c.fail(f"{key}.set.{k}", f"no such key in configs/materials/{material}.yaml")
+            *head, last = k.split(".")
+            node = mat_cfg
+            for part in head:
+                node = node[part]
+            node[last] = copy.deepcopy(v)
+    for k in st.get("rig_overrides", {}) or {}:
+        if not str(k).startswith("rig."):
+            c.fail(f"{key}.rig_overrides.{k}", "only rig keys (rig.procedure...) may be overridden here")
+
+
+def _one_d(c, st, key, material, mat_cfg, seeds):
+    kind = st["stage"]
+    _check_removed(c, st, key)
+    c.keys(st, key, ["stage", "rig", "parameter"] + ([] if kind == "density" else ["response"]),
+           ["name", "response", "target", "rig_overrides", "set", "max_runs_count", "lab_dir"])
+    _check_overrides(c, st, key, material, mat_cfg)
+    response = _response(c, st.get("response", "bulk_density_kg_m3"), f"{key}.response")
+    if response.vector:
+        c.fail(f"{key}.response", f"{response.name} is a vector (one value per lab step): a joint stage's response")
+    out = {"kind": kind, "label": stage_label(st), "rig": st["rig"], "response": response.name,
+           "target": _target(c, st.get("target"), f"{key}.target", response),
+           "rig_overrides": dict(st.get("rig_overrides") or {}), "set": dict(st.get("set") or {}),
+           "lab_dir": st.get("lab_dir"),
+           "parameter": _parameter(c, st["parameter"], f"{key}.parameter", material, mat_cfg, kind, True)}
+    out["max_runs_count"] = int(c.number(st.get("max_runs_count", DEFAULT_POINTS_COUNT * seeds),
+                                         f"{key}.max_runs_count", 2 * seeds))
+    return out
+
+
+def _joint(c, st, key, material, mat_cfg, seeds):
+    _check_removed(c, st, key)
+    c.keys(st, key, ["stage", "responses", "parameters"], ["name", "set", "max_runs_count", "lab_dir"])
+    _check_overrides(c, st, key, material, mat_cfg)
+    if not isinstance(st["parameters"], list) or not 2 <= len(st["parameters"]) <= 3:
+        c.fail(f"{key}.parameters", "a joint stage moves a list of 2 or 3 parameter groups")
+    if not isinstance(st["responses"], list) or not st["responses"]:
+        c.fail(f"{key}.responses", "must be a list of {rig, response, target, rig_overrides}")
+    resp = []
+    for j, r in enumerate(st["responses"]):
+        rk = f"{key}.responses[{j}]"
+        c.keys(r, rk, ["rig", "response"], ["target", "rig_overrides"])
+        _check_overrides(c, r, rk)
+        response = _response(c, r["response"], f"{rk}.response")
+        target = dict(r.get("target") or ({"value": 0.0, "band_z": 1.0} if response.unit == "z" else {}))
+        resp.append({"rig": r["rig"], "response": response.name,
+                     "target": _target(c, target, f"{rk}.target", response),
+                     "rig_overrides": dict(r.get("rig_overrides") or {})})
+    params = [_parameter(c, p, f"{key}.parameters[{j}]", material, mat_cfg, "joint", False)
+              for j, p in enumerate(st["parameters"])]
+    out = {"kind": "joint", "label": stage_label(st), "responses": resp, "parameters": params,
+           "set": dict(st.get("set") or {}), "lab_dir": st.get("lab_dir")}
+    out["max_runs_count"] = int(c.number(st.get("max_runs_count", DEFAULT_POINTS_COUNT * seeds * len(resp)),
+                                         f"{key}.max_runs_count", (len(params) + 1) * seeds * len(resp)))
+    return out
+
+
+def _inherit(c, st, key, done):
+    c.keys(st, key, ["stage", "from", "keys"], ["name"])
+    src = st["from"]
+    c.keys(src, f"{key}.from", ["material", "stage"], ["key"])
+    if (src["material"], src["stage"]) not in done:
+        c.fail(f"{key}.from", f"stage {src['stage']} of {src['material']} must run before this one")
+    if not isinstance(st["keys"], list) or not st["keys"]:
+        c.fail(f"{key}.keys", "must be a non-empty list of config keys")
+    return {"kind": "inherit", "label": stage_label(st), "from": dict(src), "keys": list(st["keys"])}
+
+
+def load_study(path):
+    """Validated study config with normalised stages (file, key and reason in every error)."""
+    path = Path(path)
+    data = load_yaml(path)
+    c = _Checker(path)
+    _check_removed(c, data, "")
+    c.keys(data, "", ["name", "materials", "seeds_count"], ["description", "max_runs_count", "design_case",
+                                                            "validation"])
+    if "validation" in data:
+        from . import validation
+        validation.check(data["validation"], c)
+    c.string(data["name"], "name")
+    seeds = int(c.number(data["seeds_count"], "seeds_count", 1))
+    if "max_runs_count" in data:
+        c.number(data["max_runs_count"], "max_runs_count", 1)
+    if not isinstance(data["materials"], dict) or not data["materials"]:
+        c.fail("materials", "must map material names to lists of stages")
+    out = copy.deepcopy(data)
+    done = set()
+    for mat, stages in data["materials"].items():
+        mat_cfg = copy.deepcopy(load_material(mat))
+        if not isinstance(stages, list):
+            c.fail(f"materials.{mat}", "must be a list of stages")
+        names, norm = set(), []
+        for i, st in enumerate(stages):
+            key = f"materials.{mat}[{i}]"
+            if not isinstance(st, dict) or st.get("stage") not in KINDS:
+                c.fail(f"{key}.stage", f"must be one of {', '.join(KINDS)}")
+            label = stage_label(st)
+            if label in names:
+                c.fail(f"{key}.name", f"two stages of {mat} are called {label!r}: give them different names")
+            names.add(label)
+            if st["stage"] in ONE_D:
+                n = _one_d(c, st, key, mat, mat_cfg, seeds)
+            elif st["stage"] == "joint":
+                n = _joint(c, st, key, mat, mat_cfg, seeds)
+            else:
+                n = _inherit(c, st, key, done)
+            n["config_key"] = key
+            norm.append(n)
+            done.add((mat, label))
+        out["materials"][mat] = norm
+    out["raw"] = data
+    return out

@@ -1,0 +1,251 @@
+"""Validation: predictions of tests the calibration never saw, with the calibrated values.
+
+The study config's `validation:` section lists predictions; each runs one rig on a
+material or material set with the values the stages found (nothing is fitted here) and
+compares responses with the lab, with the seed spread:
+
+    validation:
+      seeds_count: 5
+      sensitivity: {relative_step_fraction: 0.2, seeds_count: 3}   # for predictions that ask and miss
+      predictions:
+        - name: mixed_dry_pile
+          rig: aor_mixed
+          material: mixed-dry                 # a set: its components take their calibrated values
+          rig_overrides: {rig.procedure.lift_speed_m_s: 0.01}
+          sensitivity: true                   # if it misses: which calibrated value drives it
+          carry:                              # set keys that take a calibrated value of a component
+            - {to: cross_interactions.M2.M3-wet.cohesion, from: M3-wet, key: interactions.steel.cohesion}
+          compare:
+            - {response: aor_left_deg, lab: {table: angle_of_repose, sample: sample50_dry, column: left_deg},
+               band_deg: 2.0}
+            - {response: ucs, lab: {curve: ucs_fines_dry}}      # a compression curve: band z per lab step
+
+A scalar comparison is inside when |sim mean - lab| <= band (its z = (sim - lab) / band);
+a curve comparison is inside when its RMS band z is <= 1 (pycal.post.compression). A
+prediction that misses (any comparison outside) gets a sensitivity run when it asks for
+one (`sensitivity: true`, settings in the section): each calibrated parameter of the material(s) moved by +relative_step, the
+change of the first missed response per parameter, largest first ("what drives it").
+Outputs: <study>/validation.csv, validation.json, plots/validation-<name>.png.
+"""
+import copy
+import json
+import math
+from pathlib import Path
+
+from .. import labdata
+from ..errors import ConfigError, RunError
+from ..files import finite, write_csv, write_json
+from ..post import mean_std
+from ..post import compression as post_compression
+from ..post import lab_curves
+from ..plotting import new_figure, save_png
+
+CURVE = "ucs"   # compare: {response: ucs, lab: {curve: NAME}}: the result's curves against that lab curve
+
+
+def check(section, c, key="validation"):
+    """Validate the `validation:` section of a study config (c: the config checker)."""
+    c.keys(section, key, ["predictions"], ["seeds_count", "sensitivity"])
+    if "seeds_count" in section:
+        c.number(section["seeds_count"], f"{key}.seeds_count", 2)
+    if "sensitivity" in section:
+        s = section["sensitivity"]
+        c.keys(s, f"{key}.sensitivity", ["relative_step_fraction"], ["seeds_count"])
+        c.number(s["relative_step_fraction"], f"{key}.sensitivity.relative_step_fraction", 0, 1, lo_open=True)
+    preds = section["predictions"]
+    if not isinstance(preds, list) or not preds:
+        c.fail(f"{key}.predictions", "must be a non-empty list")
+    names = set()
+    for i, p in enumerate(preds):
+        k = f"{key}.predictions[{i}]"
+        c.keys(p, k, ["name", "rig", "material", "compare"], ["rig_overrides", "carry", "sensitivity"])
+        if p.get("sensitivity") and "sensitivity" not in section:
+            c.fail(f"{k}.sensitivity", "needs the section's sensitivity settings (validation.sensitivity)")
+        if p["name"] in names:
+            c.fail(f"{k}.name", f"{p['name']!r} is used twice")
+        names.add(p["name"])
+        for j, cmp in enumerate(p["compare"]):
+            ck = f"{k}.compare[{j}]"
+            bands = [b for b in cmp if b.startswith("band_")]
+            c.keys(cmp, ck, ["response", "lab"], bands)
+            lab = cmp["lab"]
+            if cmp["response"] == CURVE:
+                c.keys(lab, f"{ck}.lab", ["curve"])
+            else:
+                c.keys(lab, f"{ck}.lab", ["table", "sample", "column"])
+                if len(bands) != 1:
+                    c.fail(ck, "a scalar comparison needs one band_<unit> (the lab value's band)")
+        for j, cr in enumerate(p.get("carry", [])):
+            c.keys(cr, f"{k}.carry[{j}]", ["to", "from", "key"])
+
+
+def lab_value(spec):
+    """A lab scalar: row `sample` of labresults/<table>.csv, column `column` (None if empty)."""
+    df = labdata.load_table(spec["table"])
+    row = df[df["sample"] == spec["sample"]]
+    if row.empty or spec["column"] not in df.columns:
+        raise ConfigError(f"labresults/{spec['table']}.csv", spec["column"], f"no value for sample {spec['sample']}")
+    v = row.iloc[0][spec["column"]]
+    return None if v is None or (isinstance(v, float) and math.isnan(v)) else float(v)
+
+
+def overrides_for(study, pred):
+    """Job overrides carrying the calibrated values into the prediction's material (set)."""
+    from ..configs import material_set_names
+    material = pred["material"]
+    out = dict(pred.get("rig_overrides", {}))
+    if material in material_set_names():
+        from ..configs import load_material_set
+        comps = load_material_set(material)["components"]
+        for m in comps:
+            for k, v in study.overrides.get(m, {}).items():
+                head = k.split(".")
+                # a pair with another component is the set's cross_interactions (carry moves values there)
+                if head[0] == "interactions" and head[1] in comps and head[1] != m:
+                    continue
+                out[f"{m}.{k}"] = v
+        for cr in pred.get("carry", []):
+            src = study.overrides.get(cr["from"], {})
+            value = _value_at(src, cr["key"], cr["from"])
+            out[cr["to"]] = copy.deepcopy(value)
+    else:
+        out.update(study.overrides.get(material, {}))
+    return out
+
+
+def _value_at(overrides, key, material):
+    """The calibrated value of `key`: its override (a whole subtree set by a stage) or the
+    config's, with the overrides of its leaves applied in order."""
+    if key in overrides:
+        node = copy.deepcopy(overrides[key])
+    else:
+        from ..configs import load_material
+        node = copy.deepcopy(load_material(material))
+        for part in key.split("."):
+            node = node[part]
+    if not isinstance(node, dict):
+        return node
+    prefix = key + "."
+    for k, v in overrides.items():
+        if k.startswith(prefix):
+            sub, parts = node, k[len(prefix):].split(".")
+            for part in parts[:-1]:
+                sub = sub[part]
+            sub[parts[-1]] = v
+    return node
+
+
+def compare_results(results, cmp):
+    """One comparison over the seeds' results: sim mean and SD, lab value, band, z, inside."""
+    if cmp["response"] == CURVE:
+        targets = lab_curves.load_targets([cmp["lab"]["curve"]])
+        if not targets:
+            raise ConfigError("labresults/curves", cmp["lab"]["curve"], "no such lab curve")
+        targets["_particle_density"] = float(labdata.load_samples()["material"]["particle_density_kg_m3"])
+        zs = []
+        for r in results:
+            zs += [v["rms_z"] for v in post_compression.compare(r, targets).values() if v["rms_z"] is not None]
+        mean, sd = mean_std(zs) if zs else (math.nan, math.nan)
+        return {"response": f"{cmp['lab']['curve']} (RMS band z)", "sim_mean": mean, "sim_sd": sd, "n": len(zs),
+                "lab": 0.0, "band": 1.0, "z": mean, "inside": bool(zs) and mean <= 1.0}
+    values = [r.get(cmp["response"]) for r in results]
+    values = [v for v in values if v is not None and not (isinstance(v, float) and math.isnan(v))]
+    lab = lab_value(cmp["lab"])
+    band = next(v for k, v in cmp.items() if k.startswith("band_"))
+    mean, sd = mean_std(values) if values else (math.nan, math.nan)
+    z = (mean - lab) / band if values and lab is not None else math.nan
+    return {"response": cmp["response"], "sim_mean": mean, "sim_sd": sd, "n": len(values), "lab": lab,
+            "band": band, "z": z, "inside": bool(values) and lab is not None and abs(z) <= 1.0}
+
+
+def run(study):
+    """Run the study's validation section (if any); returns the rows (also written out)."""
+    section = study.cfg.get("validation")
+    if not section:
+        return []
+    seeds = list(range(study.seed_base, study.seed_base + int(section.get("seeds_count", len(study.seeds)))))
+    rows = []
+    for pred in section["predictions"]:
+        study.log(f"[validation] {pred['name']}: {pred['rig']} on {pred['material']} with the calibrated values")
+        extra = overrides_for(study, pred)
+        try:
+            results = study._run_seeds(pred["rig"], pred["material"], extra, seeds)
+        except RunError as exc:
+            rows.append({"prediction": pred["name"], "rig": pred["rig"], "material": pred["material"],
+                         "comparisons": [], "error": str(exc), "sensitivity": []})
+            continue
+        comps = [compare_results(results, cmp) for cmp in pred["compare"]]
+        row = {"prediction": pred["name"], "rig": pred["rig"], "material": pred["material"], "comparisons": comps,
+               "seeds": list(study.last_seeds), "sensitivity": [], "error": None,
+               "plot": plot(study, pred["name"], comps)}
+        missed = [c for c, cmp in zip(comps, pred["compare"]) if not c["inside"]]
+        if missed and pred.get("sensitivity"):
+            row["sensitivity"] = sensitivity(study, pred, extra, section["sensitivity"], missed[0],
+                                             pred["compare"][comps.index(missed[0])])
+        for c in comps:
+            study.log(f"  {c['response']}: {c['sim_mean']:.4g} +/- {c['sim_sd']:.2g} (n={c['n']}) vs lab "
+                      f"{c['lab'] if c['lab'] is not None else '-'} +/- {c['band']}: "
+                      f"{'inside' if c['inside'] else 'MISSED'}")
+        rows.append(row)
+        write(study, rows)
+    return rows
+
+
+def sensitivity(study, pred, extra, cfg, missed, cmp):
+    """Change of the missed response when each calibrated parameter of the prediction's
+    material(s) moves by +relative_step_fraction (one run set per parameter)."""
+    step = cfg["relative_step_fraction"]
+    seeds = list(range(study.seed_base, study.seed_base + int(cfg.get("seeds_count", 3))))
+    base = missed["sim_mean"]
+    out = []
+    for key, value in extra.items():
+        if key.startswith("rig.") or not isinstance(value, (int, float)) or isinstance(value, bool) or value == 0:
+            continue
+        moved = dict(extra, **{key: value * (1 + step)})
+        try:
+            res = study._run_seeds(pred["rig"], pred["material"], moved, seeds)
+        except RunError as exc:
+            out.append({"parameter": key, "value": value, "moved_to": value * (1 + step), "change": None,
+                        "error": str(exc)})
+            continue
+        c = compare_results(res, cmp)
+        out.append({"parameter": key, "value": value, "moved_to": value * (1 + step),
+                    "change": c["sim_mean"] - base, "error": None})
+        study.log(f"  sensitivity {key} x{1 + step:g}: {missed['response']} {c['sim_mean'] - base:+.3g}")
+    out.sort(key=lambda r: -abs(r["change"]) if r["change"] is not None else 0)
+    return out
+
+
+def plot(study, name, comps):
+    """Simulated mean +- SD against the lab value and its band, one bar per comparison."""
+    fig, ax = new_figure(figsize=(max(4.5, 1.3 * len(comps) + 2), 3.6))
+    for i, c in enumerate(comps):
+        if c["lab"] is not None:
+            ax.fill_between([i - 0.35, i + 0.35], c["lab"] - c["band"], c["lab"] + c["band"], color="0.85",
+                            label="lab band" if i == 0 else None)
+            ax.plot([i - 0.35, i + 0.35], [c["lab"]] * 2, color="k", lw=1, label="lab" if i == 0 else None)
+        ax.errorbar([i], [c["sim_mean"]], yerr=[c["sim_sd"]], fmt="o", color="C0", capsize=4,
+                    label="predicted (seed mean +- SD)" if i == 0 else None)
+    ax.set_xticks(range(len(comps)))
+    ax.set_xticklabels([c["response"] for c in comps], rotation=20, ha="right", fontsize=8)
+    ax.set_title(f"validation: {name}", fontsize=9)
+    ax.legend(fontsize=7)
+    fig.tight_layout()
+    rel = Path("plots") / f"validation-{name}.png"
+    save_png(fig, study.out / rel)
+    return str(rel)
+
+
+COLUMNS = ["prediction", "rig", "material", "response", "sim_mean", "sim_sd", "n", "lab", "band", "z",
+           "inside", "error"]
+
+
+def write(study, rows):
+    """validation.csv (one row per comparison) and validation.json."""
+    table = []
+    for r in rows:
+        for c in r["comparisons"] or [{}]:
+            table.append([r["prediction"], r["rig"], r["material"]] + [c.get(k, "") for k in COLUMNS[3:11]]
+                         + [r["error"] or ""])
+    write_csv(study.out / "validation.csv", COLUMNS, table)
+    write_json(study.out / "validation.json", finite(rows), default=str)

@@ -1,0 +1,41 @@
+"""The stop rule of a stage, in the parameter's own units.
+
+A stage stops when (checked in this order)
+  1. "interval within tolerance": the whole 95 % interval lies within estimate +-
+     tolerance, no more than 2.5 % of the draws point past either bound (else the
+     interval's end is the bound, not a measured end), and at least MIN_POINTS distinct
+     points have run (a line through two points cannot show its own bending: found on a
+     response that jumps where the wet cell starts to hang on);
+  2. "target beyond the upper/lower bound": at least 97.5 % of the draws point past
+     that bound and a point has been run at it: what the bounds allow cannot reach
+     the target;
+  3. "run budget spent": the next point would need more runs than the budget left.
+Only the first counts as met.
+"""
+WITHIN = "interval within tolerance"
+BUDGET = "run budget spent"
+STUDY_BUDGET = "study run budget spent"      # the whole study's max_runs_count (said by the driver)
+BEYOND_UPPER = "target beyond the upper bound"
+BEYOND_LOWER = "target beyond the lower bound"
+BOUND_SHARE = 0.025
+MIN_POINTS = 3
+
+
+def within_tolerance(estimate, low, high, tolerance):
+    """True when [low, high] lies within estimate +- tolerance (parameter units)."""
+    return max(estimate - low, high - estimate) <= tolerance
+
+
+def stop_reason(estimate, low, high, tolerance, p_below=0.0, p_above=0.0, ran_at_lower=False,
+                ran_at_upper=False, runs_left=None, runs_next=0, points_count=MIN_POINTS):
+    """The reason to stop now (one of the constants above), or None to go on."""
+    if (p_below <= BOUND_SHARE and p_above <= BOUND_SHARE and points_count >= MIN_POINTS
+            and within_tolerance(estimate, low, high, tolerance)):
+        return WITHIN
+    if p_above >= 1 - BOUND_SHARE and ran_at_upper:
+        return BEYOND_UPPER
+    if p_below >= 1 - BOUND_SHARE and ran_at_lower:
+        return BEYOND_LOWER
+    if runs_left is not None and runs_left < runs_next:
+        return BUDGET
+    return None

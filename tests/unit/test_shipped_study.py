@@ -1,0 +1,107 @@
+"""The shipped study (configs/calibrations/zinc_ore.yaml) from its first stage to its last on
+fake rigs: every stage kind runs (density, rolling resistance, stiffness in log E, wall and
+internal friction, inheritance, the wet cohesion from the wet internal-friction curve, the
+wet wall joint fit, the final rolling resistance + density pass), the outputs and the report
+are written. The fake laws are smooth and the noise small: this checks the plumbing of the
+real config, not its numbers (those need YADE)."""
+import math
+import random
+
+import pytest
+
+from fake_rigs import FakeRigs, aor_law, wall_result
+from pycal.calibration.calibrate_cli import DEFAULT_STUDY
+from pycal.calibration.study import Study
+from pycal.post import responses
+from pycal.report import write_report
+
+
+def stiffness(job):
+    """A CCS-expansion stand-in: ln(simulated / lab unloading stiffness) = 0.5 ln(E / 2e7)."""
+    e = job["materials"][job["material"]]["contact"]["youngs_modulus_pa"]
+    return {"fake_log_ratio": 0.5 * math.log(e / 2e7)}
+
+
+def internal(job):
+    """Internal friction: mu = 0.2 + 0.5 particle friction + 0.4 cohesion force fraction x
+    stress / 40 kPa; the cell hangs on where that exceeds 1.5."""
+    name = job["material"]
+    inter = job["materials"][name]["interactions"][name]
+    ff = inter["cohesion"].get("force_fraction", 0.0) if inter["cohesion"]["model"] != "none" else 0.0
+    stresses = job["rig_config"]["procedure"]["consolidation_stresses_pa"]
+    rng = random.Random(job["job_id"])
+    mu = [0.2 + 0.5 * inter["friction_coefficient"] + 0.4 * ff * s / 40000 + 0.01 * rng.gauss(0, 1)
+          for s in stresses]
+    sticks = [m > 1.5 for m in mu]
+    return {"stress_pa": stresses, "mu_static": [None if st else m for m, st in zip(mu, sticks)],
+            "mu_dynamic": [None if st else m for m, st in zip(mu, sticks)], "sticks": sticks}
+
+
+def mixed_pile(job):
+    """The mixed -50 mm pile (validation): every direction and the upper part at 35 deg."""
+    return {k: 35.0 for k in ("aor_left_deg", "aor_right_deg", "aor_front_deg", "aor_back_deg",
+                              "aor_upper_left_deg", "aor_upper_right_deg")}
+
+
+def surcharge(job):
+    """The surcharge angle (validation): 0.6 x the fake AoR law."""
+    a = 0.6 * aor_law(job)
+    return {"surcharge_left_deg": a, "surcharge_right_deg": a}
+
+
+def ucs(job):
+    """A UCS stand-in on the lab's own curve shape (validation): bulk stiffness 60 x stress,
+    bulk density 2750 - 1149 exp(-stress / 150 kPa)."""
+    stress = [3000.0, 6000.0, 12000.0, 24000.0, 40000.0]
+    return {"stress_pa": stress, "stiffness_pa": [60 * s for s in stress],
+            "bulk_density_kg_m3": [2750 - 1149 * math.exp(-s / 150000) for s in stress]}
+
+
+def wall(steel, s):
+    coh = steel["cohesion"]
+    return steel["friction_coefficient"] + (3e-4 * coh.get("pressure_fraction", 0.0) * s
+                                            if coh["model"] == "hysteretic" else 0.0)
+
+
+@pytest.fixture
+def fake_stiffness_response(monkeypatch):
+    """The stiffness response read from the stand-in's key (the real one reads spring curves)."""
+    fake = responses.Response("unloading_stiffness_log_ratio", "log_ratio", False,
+                              lambda r, lab: float(r["fake_log_ratio"]))
+    monkeypatch.setitem(responses.RESPONSES, "unloading_stiffness_log_ratio", fake)
+
+
+def test_the_shipped_study_runs_every_stage_on_fake_rigs(tmp_path, fake_stiffness_response):
+    def wall_rig(job):
+        stresses = job["rig_config"]["procedure"]["consolidation_stresses_pa"]
+        return wall_result(wall, stresses=tuple(stresses))(job)
+    ex = FakeRigs(results={"ccs_expansion": stiffness, "internal_friction": internal, "wall_friction": wall_rig,
+                           "aor_mixed": mixed_pile, "surcharge": surcharge, "ucs": ucs},
+                  noise={"fake_log_ratio": 0.03})
+    study = Study(DEFAULT_STUDY, ex, tmp_path / "out", log=lambda m: None, seed_base=7)
+    rows = study.run()
+    labels = [(r["material"], r["stage"]) for r in rows]
+    assert len(labels) == sum(len(s) for s in study.cfg["materials"].values())
+    assert study.runs_requested <= study.cfg["max_runs_count"]
+    by = {(r["material"], r["stage"]): r for r in rows}
+    # E: log ratio 0 at 2e7 Pa (M3-dry's bound is 2.4e7: reachable)
+    for m in ("M2", "M3-dry"):
+        e = by[(m, "stiffness")]["parameters"][0]
+        assert e["low"] <= 2e7 <= e["high"] or abs(e["estimate"] / 2e7 - 1) < 0.2
+    # the wet cohesion stage ran on the internal-friction rig and the wet cell hangs on
+    coh = by[("M3-wet", "cohesion")]
+    assert coh["responses"][0]["response"] == "friction_angle_offset_deg" and coh["points_count"] >= 2
+    final = by[("M2", "rolling_density_final")]
+    assert [p["label"] for p in final["parameters"]] == ["rolling resistance (M2, steel, PVC)", "particle density"]
+    assert len(final["correlation"]) == 2
+    assert all(j["seed"] >= 7 for j in ex.asked)
+    # validation: every prediction of the shipped config ran with the calibrated values
+    names = [r["prediction"] for r in study.validation_rows]
+    assert names == [p["name"] for p in study.cfg["validation"]["predictions"]]
+    dry = next(r for r in study.validation_rows if r["prediction"] == "mixed_dry_pile")
+    assert dry["comparisons"][0]["sim_mean"] == pytest.approx(35.0, abs=2.0)
+    assert all(j["seed"] >= 7 for j in ex.asked if j["rig"] == "aor_mixed")
+    fines = next(r for r in study.validation_rows if r["prediction"] == "fines_dry_ucs")
+    assert fines["comparisons"][0]["n"] > 0 and fines["comparisons"][0]["inside"]
+    html = write_report(study.out).read_text()
+    assert "YADE 2023.02a-fake" in html and "rolling_density_final" in html

@@ -1,0 +1,118 @@
+"""Validation (pycal.calibration.validation): a prediction runs with the calibrated values,
+is compared with the lab band, and a miss gets a sensitivity ranking. Fake physics of
+tests/unit/fake_rigs.py: AoR = 20 + 40 x rolling resistance (deg), seed noise 0.5 deg;
+the surcharge angle of the fake surcharge rig = 0.6 x the AoR."""
+import json
+
+import pytest
+
+from fake_rigs import FakeRigs, aor_law
+from pycal.calibration.study import Study
+from pycal.errors import ConfigError
+
+STUDY = """
+name: val
+seeds_count: 3
+max_runs_count: 300
+materials:
+  M3-dry:
+    - stage: rolling_resistance
+      rig: aor
+      response: aor_mean_deg
+      target: {sample: fines_dry, test: angle_of_repose, band_deg: 1.0}
+      parameter:
+        keys: [interactions.M3-dry.rolling_resistance_coefficient,
+               interactions.steel.rolling_resistance_coefficient,
+               interactions.pvc.rolling_resistance_coefficient]
+        start: 0.35
+        bounds: [0.05, 1.5]
+        response_increases: true
+        tolerance_coefficient: 0.02
+      max_runs_count: 30
+validation:
+  seeds_count: 4
+  sensitivity: {relative_step_fraction: 0.2, seeds_count: 2}
+  predictions:
+    - name: fines_dry_aor_left
+      rig: aor
+      material: M3-dry
+      compare:
+        - {response: aor_mean_deg, lab: {table: angle_of_repose, sample: fines_dry, column: left_deg}, band_deg: 2.0}
+    - name: fines_dry_surcharge
+      rig: surcharge
+      material: M3-dry
+      sensitivity: true
+      compare:
+        - {response: surcharge_mean_deg, lab: {table: surcharge, sample: fines_dry, column: left_deg}, band_deg: 2.0}
+"""
+
+
+def surcharge(job):
+    return {"surcharge_mean_deg": 0.6 * aor_law(job)}
+
+
+@pytest.fixture
+def study(tmp_path):
+    p = tmp_path / "val.yaml"
+    p.write_text(STUDY)
+    ex = FakeRigs(results={"surcharge": surcharge}, noise={"surcharge_mean_deg": 0.5})
+    s = Study(p, ex, tmp_path / "out", log=lambda m: None)
+    s.run()
+    return s, ex
+
+
+def test_predictions_use_the_calibrated_values_and_compare_with_the_lab_band(study):
+    s, ex = study
+    rolling = s.overrides["M3-dry"]["interactions.M3-dry.rolling_resistance_coefficient"]
+    assert 20 + 40 * rolling == pytest.approx(38.0, abs=1.0)            # the lab's fines_dry AoR
+    aor, sur = s.validation_rows
+    # the prediction ran at the calibrated rolling resistance, on its own seeds count
+    runs = [j for j in ex.asked if j["rig"] == "surcharge"]
+    assert {j["materials"]["M3-dry"]["interactions"]["M3-dry"]["rolling_resistance_coefficient"]
+            for j in runs[:4]} == {rolling}
+    assert aor["comparisons"][0]["n"] == 4
+    # AoR: lab left 38 deg (band 2): inside. Surcharge: 0.6 x ~38 = ~22.8 vs lab 29: a miss by ~3 bands
+    assert aor["comparisons"][0]["inside"] and aor["sensitivity"] == []
+    c = sur["comparisons"][0]
+    assert not c["inside"] and c["lab"] == 29.0
+    assert c["z"] == pytest.approx((c["sim_mean"] - 29.0) / 2.0)
+    assert c["sim_mean"] == pytest.approx(0.6 * (20 + 40 * rolling), abs=1.0)
+    # the miss is driven by the rolling resistance (the only calibrated value): +20 % -> +0.6 x 40 x 0.2 x eta
+    top = sur["sensitivity"][0]
+    assert top["parameter"] == "interactions.M3-dry.rolling_resistance_coefficient"
+    assert top["change"] == pytest.approx(0.6 * 40 * 0.2 * rolling, abs=0.8)
+
+
+def test_summary_separates_calibrated_on_from_predicted(study):
+    s, _ = study
+    summary = json.loads((s.out / "summary.json").read_text())
+    assert [c["stage"] for c in summary["calibrated_on"]] == ["rolling_resistance"]
+    assert [p["prediction"] for p in summary["predicted"]] == ["fines_dry_aor_left", "fines_dry_surcharge"]
+    rows = (s.out / "validation.csv").read_text().splitlines()
+    assert rows[0].startswith("prediction,rig,material,response,sim_mean")
+    assert (s.out / "plots" / "validation-fines_dry_surcharge.png").is_file()
+    from pycal.report import write_report
+    html = write_report(s.out).read_text()
+    assert "Predicted (validation" in html and "missed" in html and "what drives the miss" in html
+
+
+def test_a_scalar_comparison_needs_one_band(tmp_path):
+    p = tmp_path / "bad.yaml"
+    p.write_text(STUDY.replace(", band_deg: 2.0}\n    - name: fines_dry_surcharge", "}\n    - name: fines_dry_surcharge"))
+    from pycal.calibration.study_config import load_study
+    with pytest.raises(ConfigError, match=r"validation.predictions\[0\].compare\[0\]: a scalar comparison needs one "
+                                          r"band_<unit>"):
+        load_study(p)
+
+
+def test_carry_takes_a_subtree_with_its_calibrated_leaves():
+    """A stage switched the fines-steel pair to hysteretic (`set:`) and a later stage moved its
+    pressure_fraction: the carried value is the switched pair with the moved leaf."""
+    from pycal.calibration.validation import _value_at
+    overrides = {"interactions.steel.cohesion": {"model": "hysteretic", "force_fraction": 0.0,
+                                                 "pressure_fraction": 0.0, "update_interval_s": 0.01},
+                 "interactions.steel.cohesion.pressure_fraction": 0.012}
+    got = _value_at(overrides, "interactions.steel.cohesion", "M3-wet")
+    assert got == {"model": "hysteretic", "force_fraction": 0.0, "pressure_fraction": 0.012, "update_interval_s": 0.01}
+    # no override: the config's own value
+    assert _value_at({}, "interactions.steel.cohesion", "M3-wet")["model"] == "force_fraction"
