@@ -7,8 +7,11 @@ velocity and bulk density it has there after its fall from the belt (pycal.strea
 demlib.feeder), for `feed_time_s`; the scene then runs `holdup_wait_s` more. Particles whose
 centre passes the plate's lower end have run off, those that fall back past its top end (upstream of
 it and below it) have spilled upstream: both are
-erased and their mass counted (after an erasure the collider is made to sort all its
-bounds again: YADE 2023.02a's periodic collider hangs otherwise). A particle is in flight
+erased and their mass counted. The collider sorts all its bounds afresh at every time step
+(YADE 2023.02a's incremental periodic sort, InsertionSortCollider::insertionSortPeri, never
+returned in this scene: after an erasure, and with lumps in the stream even without one -
+a mixed-dry run hung at t = 0.085 s, gdb showed the loop; the full sort of a few hundred
+bounds costs little). A particle is in flight
 from its injection to its first contact with anything (checked with the plate forces, every
 force_sample_interval_count steps), then on the plate. Every record interval the masses in
 flight, on the plate and gone are recorded with the plate's normal forces averaged over the
@@ -21,6 +24,9 @@ a plate facet exactly one period wide loses the particles that drift across the 
 +-10 m across the slice, far beyond any particle's drift (a particle that still reaches
 +-4 m fails the run as escaped); particle-particle contacts are periodic as usual.
 
+The procedure is a generator (demlib.phases) driven by demlib.replicas.rig_main like every
+rig; lone jobs only (a periodic cell has no room for replicas side by side).
+
 Outputs: result.json, transfer_record.csv, plate_stress_profile.csv, transfer_record.png,
 frames/transfer_NNNN.png (side view every frame_interval_s).
 Run: yade -j1 -x -n yade_scripts/transfer.py job.json
@@ -30,9 +36,10 @@ import os
 import sys
 
 from yade_scripts.demlib.jobio import RigFailure, run_rig, write_csv
-from yade_scripts.demlib import mixed
+from yade_scripts.demlib import mixed, replicas
 from yade_scripts.demlib.feeder import Feeder
 
+SORT_HOOK = "_pycal_transfer_full_sort"
 GUARD_HALF_WIDTH_M = 4.0     # a particle drifting farther across the slice than this has escaped
 
 
@@ -105,13 +112,14 @@ class Plate:
 class Transfer:
     """The scene, the feeder, the plate and the bookkeeping of where the mass is."""
 
-    def __init__(self, job):
+    def __init__(self, scene):
         from yade import O
         from pycal import stream
         from pycal.step_estimate import critical_timestep
+        job = scene.job
         self.job = job
         self.geo = stream.check_job(job)
-        self.scene = mixed.MixedScene(job)
+        self.scene = scene
         sc = self.scene
         g = self.geo
         top, L = g["plate_top_m"], g["plate_length_m"]
@@ -123,6 +131,7 @@ class Transfer:
         O.cell.setBox(size_x, W, size_z)
         self.collider = [e for e in O.engines if type(e).__name__ == "InsertionSortCollider"][0]
         self.collider.allowBiggerThanPeriod = True
+        self._sort_every_step()
         self.plate = Plate(sc, g)
         sc.set_domain((top[0] - 1.0, -GUARD_HALF_WIDTH_M, stream.PLATE_APEX_Z_M - 0.5),
                       (top[0] + L * g["plate_tangent"][0] + 1.0, GUARD_HALF_WIDTH_M, wz + 1.0))
@@ -205,6 +214,19 @@ class Transfer:
                     self.flying.discard(i)
         return in_flight, on_plate
 
+    def _sort_every_step(self):
+        """A PyRunner first in the engines sets the collider's doSort flag before every step
+        (module doc: the periodic collider's incremental sort hangs on this YADE build)."""
+        import __main__
+        from yade import O
+        from yade.wrapper import PyRunner
+        collider = self.collider
+
+        def force_sort():
+            collider.doSort = True
+        setattr(__main__, SORT_HOOK, force_sort)
+        O.engines = [PyRunner(command=SORT_HOOK + "()", iterPeriod=1, label="transfer_full_sort")] + list(O.engines)
+
     def resort(self):
         """Make the collider sort all bounds again at its next run. YADE 2023.02a: after bodies
         are erased from a periodic scene, InsertionSortCollider's incremental sort never
@@ -231,10 +253,14 @@ class Transfer:
         return rows
 
 
-def main(job, out_dir):
+def procedure(scene, out_dir):
+    """The transfer run (a generator: demlib.phases): feed, then wait; returns the measurements.
+    Steps are asked for in chunks that end at every force sample (each
+    measure.force_sample_interval_count steps) and at every layer's injection time."""
     from yade import O
     from pycal.post import transfer as post
-    rig = Transfer(job)
+    job = scene.job
+    rig = Transfer(scene)
     sc, g, plate, feeder = rig.scene, rig.geo, rig.plate, rig.feeder
     m, p = sc.rig["measure"], sc.rig["procedure"]
     t_end = rig.feed_time + p["holdup_wait_s"]
@@ -242,7 +268,6 @@ def main(job, out_dir):
     next_record, next_guard, next_frame = m["record_interval_s"], sc.num["rest_check_interval_s"], 0.0
     steady = m["steady_from_s"]
     records, frames = [], []
-    step = O.step
     k = 0
     while O.time < t_end - 1e-12:
         while feeder.due(O.time):
@@ -251,8 +276,11 @@ def main(job, out_dir):
         if O.time >= next_frame - 1e-12:
             frames.append((O.time, rig.frame_rows()))
             next_frame += m["frame_interval_s"]
-        step()
-        k += 1
+        chunk = every - k % every
+        if feeder.layers_done < feeder.n_layers:      # stop at the next layer's time
+            chunk = min(chunk, max(1, int(math.ceil((feeder.layers_done * feeder.dt - O.time) / O.dt - 1e-9))))
+        yield chunk
+        k += chunk
         if k % every == 0:
             plate.sample(profile=steady <= O.time <= rig.feed_time)
             rig.track_flight()
@@ -311,6 +339,8 @@ def main(job, out_dir):
         out[f"mass_fraction_{name}_fed"] = fed[name] / total_fed if total_fed > 0 else 0.0
     return out
 
+
+main = replicas.rig_main(procedure, scene_class=mixed.MixedScene)
 
 if __name__ == "__main__" and os.path.basename(sys.argv[0]) == "transfer.py":
     run_rig(main)

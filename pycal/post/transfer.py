@@ -49,7 +49,7 @@ def summarise(records, geo, measure, feed_time_s, holdup_wait_s):
     throughput_in/out = fed / run-off mass change over the window per second;
     holdup_growth_kg_s = least-squares slope of the on-plate mass over the window, and
     on_plate_mass_mean_kg its mean;
-    plugs = throughput_out < plug_outflow_ratio x throughput_in."""
+    plugged = throughput_out < plug_outflow_ratio x throughput_in."""
     t0, t1 = measure["steady_from_s"], feed_time_s
     rows = window_rows(records, t0, t1)
     if len(rows) < 2:
@@ -76,7 +76,7 @@ def summarise(records, geo, measure, feed_time_s, holdup_wait_s):
         "outflow_ratio": q_out / q_in,
         "holdup_growth_kg_s": growth,
         "on_plate_mass_mean_kg": float(np.mean(on_plate)),
-        "plugs": bool(q_out < measure["plug_outflow_ratio"] * q_in),
+        "plugged": bool(q_out < measure["plug_outflow_ratio"] * q_in),
         "holdup_mass_kg": end["on_plate_mass_kg"],
         "holdup_time_s": end["time_s"] - feed_time_s,
         "fed_mass_kg": end["fed_mass_kg"],

@@ -95,7 +95,7 @@ def test_the_plate_carries_the_streams_momentum_and_the_bed(m2):
     assert res["design_impact_stress_pa"] == pytest.approx(RHO0 * V0 * vz, rel=1e-12)
     # the footprint takes most of the stream's normal momentum, never more than all of it and the bed
     assert 0.5 * res["momentum_flux_stress_pa"] < res["impact_stress_pa"] < 1.2 * res["momentum_flux_stress_pa"]
-    assert not res["plugs"] and res["outflow_ratio"] > 0.8
+    assert not res["plugged"] and res["outflow_ratio"] > 0.8
     assert_documented(res)
 
 
