@@ -1,9 +1,10 @@
 """VTK snapshots of a rig run for ParaView (runs inside YADE): the job's `vtk` entry
 (pycal/vtk_output.py, `--vtk`) makes every scene write YADE VTKRecorder snapshots.
 
-Scene.__init__ calls end_scene() before it resets YADE and begin_scene(job) once its
-engines are built; jobio.run_rig calls finish() after the rig's main() returned. Per scene
-k (a rig with a fresh fill per step has several) a dead VTKRecorder in O.engines and a
+demlib.scene.World.__init__ calls end_scene() before it resets YADE and begin_scene(job)
+once its engines are built; jobio.run_rig calls finish() after the rig's main() returned.
+Per YADE scene k (one per World: a rig with a fresh fill per step or a sequential batch has
+several; side-by-side replicas share one) a dead VTKRecorder in O.engines and a
 PyRunner that calls it every `interval_s` of simulated time, the first at the scene's first
 step, and a last snapshot when the scene ends. Files in <job folder>/<folder>/:
 
