@@ -13,8 +13,9 @@ code:
   spheres, the plate is one facet, and mid-feed the fastest particle moves at the stream's
   speed between the injection window and the plate (12.33 - 12.45 m/s).
 
-M2 (spheres, seed 1) with a 0.5 s feed; mixed-dry (lumps too) with a 0.25 s feed for the
-balance with lumps.
+M2 (spheres, seed 1) with a 0.5 s feed; mixed-dry and mixed-wet (lumps too) with a 0.25 s
+feed for the balance with lumps and their VTK snapshots (lump members carry their clump's
+id). Each run takes well under a minute of wall time.
 """
 import math
 import re
@@ -135,11 +136,13 @@ def test_vtk_snapshots_hold_the_scene(m2):
     assert 12.3 < arrays["linVelLen"][1] < 12.46       # the stream between window and plate, nothing faster
 
 
-def test_a_mixed_set_keeps_its_balance_with_lumps(tmp_path_factory):
+@pytest.mark.parametrize("material, fines", [("mixed-dry", "M3-dry"), ("mixed-wet", "M3-wet")])
+def test_a_mixed_set_keeps_its_balance_with_lumps(tmp_path_factory, material, fines):
     over = {"rig.procedure.feed_time_s": 0.25, "rig.procedure.holdup_wait_s": 0.05, "rig.measure.steady_from_s": 0.1,
             "rig.measure.frame_interval_s": 0.3}
-    job = resolve_job("transfer", "mixed-dry", over, seed=2)
-    res = run_job(job, runs_dir=tmp_path_factory.mktemp("transfer_mixed"), timeout_s=900)
+    job = with_vtk(resolve_job("transfer", material, over, seed=2), VTK_INTERVAL_S)
+    runs = tmp_path_factory.mktemp("transfer_mixed")
+    res = run_job(job, runs_dir=runs, timeout_s=900)
     # the heaviest particle: a 50 mm rounded lump, the union of 27 spheres of 12.5 mm on a 3 x 3 x 3
     # grid 12.5 mm apart, at most a 50 mm cube of 2750 kg/m3 (0.344 kg)
     heaviest = 2750 * 0.05 ** 3
@@ -148,6 +151,17 @@ def test_a_mixed_set_keeps_its_balance_with_lumps(tmp_path_factory):
         print(when, "fed", fed, parts)
         assert abs(fed - sum(parts.values())) <= heaviest
     assert res["fed_mass_kg"] == pytest.approx(SLICE_FLOW * 0.25, abs=heaviest)
-    for name in ("M2", "M3-dry"):
+    for name in ("M1", "M2", fines):
         assert res[f"mass_fraction_{name}_fed"] == pytest.approx(res[f"mass_fraction_{name}_requested"], abs=0.03)
+    # the last VTK snapshot holds every particle sphere left (lump members counted), the lumps' members
+    # with their clump's id, three materials at most (YADE ids 0 - 2: the set's components)
+    vtk = runs / "transfer" / job["job_id"] / "vtk"
+    spheres = _collection(vtk, "transfer", "spheres")
+    assert len(spheres) == res["vtk_snapshots_count"] and all(f.is_file() for _, f in spheres)
+    mid = min(spheres, key=lambda s: abs(s[0] - 0.2))        # the stream, lumps among it
+    n_mid, _, arrays = _vtu_header(mid[1])
+    print("mid-feed snapshot", mid, n_mid, arrays)
+    assert n_mid > 50 and arrays["clumpId"][1] >= 0 and 0.0 <= arrays["materialId"][0] <= arrays["materialId"][1] <= 2.0
+    n_end, _, _ = _vtu_header(spheres[-1][1])
+    assert n_end == res["n_particle_spheres_end"]
     assert_documented(res)
