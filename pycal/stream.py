@@ -193,12 +193,53 @@ def layer_times(job):
     return n, proc["feed_time_s"] / n
 
 
+# every key of the rig config's sections: (section.key, kind) with kind "number" (finite),
+# "positive" (> 0), "non_negative" (>= 0), "count" (a whole number >= 1) or "boundary"
+KEYS = (("geometry.plate_material", "boundary"), ("geometry.plate_inclination_deg", "number"),
+        ("geometry.plate_length_m", "positive"), ("geometry.impact_point_from_plate_top_m", "number"),
+        ("geometry.slice_width_m", "positive"), ("geometry.stream_width_m", "positive"),
+        ("procedure.design_drop_height_m", "positive"), ("procedure.design_belt_speed_m_s", "positive"),
+        ("procedure.design_mass_flow_kg_s", "positive"), ("procedure.design_belt_bulk_density_kg_m3", "positive"),
+        ("procedure.injection_height_m", "positive"), ("procedure.injection_layer_thickness_m", "positive"),
+        ("procedure.placement_max_attempts_count", "count"), ("procedure.feed_time_s", "positive"),
+        ("procedure.holdup_wait_s", "non_negative"), ("measure.steady_from_s", "non_negative"),
+        ("measure.plug_outflow_ratio", "number"), ("measure.record_interval_s", "positive"),
+        ("measure.force_sample_interval_count", "count"), ("measure.speed_gauge_height_m", "positive"),
+        ("measure.stress_profile_bin_m", "positive"), ("measure.frame_interval_s", "positive"))
+
+
+def _check_types(job):
+    """Every key of KEYS present and of its kind (ConfigError naming the key)."""
+    rig = job["rig_config"]
+    for key, kind in KEYS:
+        section, name = key.split(".")
+        if name not in rig.get(section, {}):
+            _fail(key, "missing")
+        value = rig[section][name]
+        if kind == "boundary":
+            if value not in job["boundaries"]:
+                _fail(key, f"{value!r} is not a boundary material (configs/boundaries.yaml: "
+                           f"{', '.join(sorted(job['boundaries']))})")
+            continue
+        if kind == "count":
+            if isinstance(value, bool) or not isinstance(value, int) or value < 1:
+                _fail(key, f"{value!r} must be a whole number >= 1")
+            continue
+        if isinstance(value, bool) or not isinstance(value, (int, float)) or not math.isfinite(value):
+            _fail(key, f"{value!r} must be a number")
+        if kind == "positive" and not value > 0:
+            _fail(key, f"{value!r} must be > 0")
+        if kind == "non_negative" and not value >= 0:
+            _fail(key, f"{value!r} must be >= 0")
+
+
 def check_job(job):
     """Refuse a transfer job whose geometry cannot work (ConfigError naming the rig-config key:
     exit 2, nothing written). Checked: the design case is one the impact rule covers, the
     plate, the injection window above the plate, the stream meeting the plate within its
     length, the slice wider than two of the largest particles, placeable stream density, and
     the measurement window inside the feed."""
+    _check_types(job)
     H, v0, Q, rho0, g = design_case(job)
     geo, proc, meas = (job["rig_config"][k] for k in ("geometry", "procedure", "measure"))
     for key, value in (("procedure.design_drop_height_m", H), ("procedure.design_belt_speed_m_s", v0),

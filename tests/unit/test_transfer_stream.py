@@ -90,6 +90,11 @@ def test_layers_cover_the_feed_time_and_stay_thin():
     ({"rig.measure.steady_from_s": 1.5}, "measure.steady_from_s", "before the feed stops"),
     ({"rig.measure.plug_outflow_ratio": 0.0}, "measure.plug_outflow_ratio", "must be within (0, 1]"),
     ({"rig.procedure.feed_time_s": -1.0}, "procedure.feed_time_s", "must be > 0"),
+    ({"rig.measure.steady_from_s": "abc"}, "measure.steady_from_s", "'abc' must be a number"),
+    ({"rig.procedure.holdup_wait_s": -0.5}, "procedure.holdup_wait_s", "must be >= 0"),
+    ({"rig.procedure.placement_max_attempts_count": 0}, "procedure.placement_max_attempts_count",
+     "must be a whole number >= 1"),
+    ({"rig.geometry.plate_material": "wood"}, "geometry.plate_material", "'wood' is not a boundary material"),
 ])
 def test_bad_geometry_is_refused_in_one_line(tmp_path, capsys, over, key, why):
     args = ["run", "transfer", "--material", "M2", "--out", str(tmp_path)]
