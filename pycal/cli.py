@@ -35,7 +35,11 @@ def _make_jobs(args):
     from .jobs import parse_set, resolve_job
     overrides = parse_set(args.set)
     seeds = list(range(args.seed, args.seed + args.seeds))
-    return [resolve_job(args.rig, args.material, overrides, seed=s) for s in seeds]
+    jobs = [resolve_job(args.rig, args.material, overrides, seed=s) for s in seeds]
+    if args.vtk is not None:                  # --vtk: snapshots for ParaView (pycal/vtk_output.py)
+        from .vtk_output import with_vtk
+        jobs = [with_vtk(j, args.vtk) for j in jobs]
+    return jobs
 
 
 def _cmd_run(args):
@@ -122,6 +126,10 @@ def build_parser():
         s.add_argument("--seed", type=int, default=1, help="random seed of the fill (default 1)")
         s.add_argument("--seeds", type=int, default=1, help="run this many seeds: seed, seed+1, ...")
         s.add_argument("--out", default=str(DEFAULT_RUNS_DIR), help="runs directory (default runs/)")
+        from .vtk_output import DEFAULT_INTERVAL_S
+        s.add_argument("--vtk", nargs="?", type=float, const=DEFAULT_INTERVAL_S, default=None, metavar="INTERVAL_S",
+                       help="also write VTK snapshots for ParaView into the job folder's vtk/, every INTERVAL_S "
+                            f"of simulated time (default {DEFAULT_INTERVAL_S:g} s); part of the job")
 
     s = sub.add_parser("run", help="run one rig job (or several seeds) in YADE")
     job_args(s)

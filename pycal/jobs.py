@@ -141,6 +141,7 @@ def _finish_job(rig, rig_cfg, seed, material, materials, overrides, config_dir, 
     if material_set is not None:
         job["material_set"] = material_set
     check_contacts(job)
+    check_rig_geometry(job)
     job["job_id"] = job_id(job)
     step_estimate.check(job)      # refuses a job that would run for an implausible number of steps
     return job
@@ -162,6 +163,15 @@ def check_contacts(job):
             raise ConfigError(f"configs/numerics.yaml or configs/rigs/{job['rig']}.yaml", ".".join(parts[2:]),
                               exc.reason) from None
         raise ConfigError(f"job {job['rig']}/{job['material']}", exc.key, exc.reason) from None
+    return job
+
+
+def check_rig_geometry(job):
+    """Rig-specific checks of a job that need more than the config's keys (the transfer rig:
+    pycal.stream.check_job); a ConfigError names the rig config's key."""
+    if job["rig_config"]["script"] == "transfer.py":
+        from . import stream
+        stream.check_job(job)
     return job
 
 

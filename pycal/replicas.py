@@ -30,8 +30,8 @@ LAYOUTS = ("side_by_side", "sequential")
 # rig -> largest batch (replicas per YADE run). Not listed: the tilt-table friction rigs
 # (gravity is rotated for the whole scene: replicas would share one tilt, and a seed's
 # hold at its own onset angle could not happen; their process cost is < 1 % of a curve)
-# and aor_mixed (its time step comes from the lumps drawn: replicas would share the
-# smallest of the batch).
+# aor_mixed (its time step comes from the lumps drawn: replicas would share the
+# smallest of the batch) and transfer (a periodic cell: no room for a copy beside it).
 REPLICA_RIGS = {"fill": 8, "aor": 8, "surcharge": 8, "ccs": 8, "ccs_expansion": 8, "ucs": 8}
 
 

@@ -11,7 +11,8 @@ steps = longest simulated time of the rig (s) / time step (s).
   wait (settle, load step) ends after at most numerics.max_settle_time_s (plus one rest
   check interval) or the rig fails; a cylinder lift ends by its own time limit
   (1.5 x the lift height / lift speed + 1 s); a tilt test tilts to max_tilt_deg, holds,
-  resumes and tilts back (docs/rigs.md lists each rig's phases).
+  resumes and tilts back; the transfer rig runs its feed time and its holdup wait
+  (docs/rigs.md lists each rig's phases).
 
 A job above numerics.max_estimated_steps_count is refused at job resolution with one
 line naming the values that drive the estimate (pycal.jobs.resolve_job).
@@ -111,6 +112,9 @@ def _phases(job):
         return fill + lift() + waits("load steps", len(p["load_steps_pa"]), "rig.procedure.load_steps_pa")
     if script in ("wall_friction.py", "internal_friction.py"):
         return fill + _tilt_phases(p, wait, settle_key)
+    if script == "transfer.py":          # no fill, no rest wait: the feed and the holdup wait, run to the end
+        return [("feed", p["feed_time_s"], "rig.procedure.feed_time_s"),
+                ("holdup wait after the feed", p["holdup_wait_s"], "rig.procedure.holdup_wait_s")]
     # a rig without its own rule: its fill only (add the rule here with the rig)
     return fill
 

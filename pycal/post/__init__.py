@@ -1,7 +1,7 @@
 """Post-processing of rig results: summaries, statistics over seeds.
 
 Rig-specific modules: aor and aor_mixed (pile angles), compression (spring curves),
-friction (tilt records); lab_curves (lab targets and misfits, shared), cli (the shared
+friction (tilt records), transfer (the belt-stream rig's record); lab_curves (lab targets and misfits, shared), cli (the shared
 command line of the modules).
 """
 import math

@@ -100,3 +100,12 @@ def test_cli_refusal_is_one_line_exit_2_and_writes_nothing(tmp_path, capsys):
     err = capsys.readouterr().err.strip().splitlines()
     assert len(err) == 1 and err[0].startswith("error: --set: contact.youngs_modulus_pa=1e+15:")
     assert not out.exists()
+
+
+def test_the_transfer_rig_runs_its_feed_and_its_holdup_wait():
+    # no rest waits: feed_time_s 1.2 s + holdup_wait_s 1.0 s at M2's step: 2.2 / 7.3288e-5 = 30 018 steps;
+    # the mixed sets at the smallest lump member's step: 2.2 / 3.018e-5 = 72 900
+    e = se.estimate(resolve_job("transfer", "M2"))
+    assert e["simulated_time_s"] == pytest.approx(2.2) and e["steps_count"] == pytest.approx(30018, rel=1e-3)
+    assert [key for _, _, key in e["phases"]] == ["rig.procedure.feed_time_s", "rig.procedure.holdup_wait_s"]
+    assert se.estimate(resolve_job("transfer", "mixed-wet"))["steps_count"] == pytest.approx(72900, rel=2e-3)

@@ -16,6 +16,7 @@ import traceback
 
 _T0 = time.time()
 _STARTED = datetime.datetime.now(datetime.timezone.utc).isoformat(timespec="seconds")
+_JOB_DIR = None       # folder of the job file being run (load_job), where every output goes
 
 
 from pycal.contact_rules import law_of_job
@@ -66,6 +67,7 @@ def job_path_from_argv():
 
 def load_job():
     """(job dict, output folder)."""
+    global _JOB_DIR
     path = os.path.abspath(job_path_from_argv())
     try:
         with open(path) as f:
@@ -76,7 +78,14 @@ def load_job():
         raise JobFileError(f"job file {path}: not valid JSON ({exc})") from None
     if not isinstance(job, dict):
         raise JobFileError(f"job file {path}: not a job (a JSON object is expected)")
-    return job, os.path.dirname(path)
+    _JOB_DIR = os.path.dirname(path)
+    return job, _JOB_DIR
+
+
+def job_folder():
+    """The folder of the job being run (the current directory if no job file was loaded:
+    test scenes)."""
+    return _JOB_DIR or os.getcwd()
 
 
 def provenance():
@@ -152,6 +161,10 @@ def run_rig(main):
         os._exit(EXIT_ERROR)
     try:
         measurements = main(job, out_dir)
+        from . import vtk_output
+        snapshots = vtk_output.finish()
+        if snapshots is not None:
+            measurements["vtk_snapshots_count"] = snapshots
         write_result(out_dir, job, measurements)
     except RigFailure as exc:
         print(f"RIG FAILED: {exc}", flush=True)

@@ -16,6 +16,7 @@ from yade import Vector3
 
 from .contact_models import make_contact_model
 from .jobio import RigFailure, OverlapLimitExceeded
+from . import vtk_output
 from .phases import Barrier, steps_of
 
 
@@ -30,6 +31,7 @@ class World:
     def __init__(self, job):
         self.num = job["rig_config"]["numerics"]
         self.g = self.num["gravity_m_s2"]
+        vtk_output.end_scene()       # a world before this one (a fresh fill per step, a sequential replica) writes its last snapshot
         O.reset()
         self.contact = make_contact_model(job, gravity=self.g)   # the law of pycal.contact_rules.law_of_job
         self.newton = NewtonIntegrator(gravity=(0, 0, -self.g), damping=self.contact.damping(),
@@ -39,6 +41,7 @@ class World:
             InsertionSortCollider(self.contact.bounding_functors(), label="collider"),
             InteractionLoop(self.contact.geometry_functors(), self.contact.ip2_functors(), [self.contact.law2()]),
         ] + self.contact.extra_engines() + [self.newton]
+        vtk_output.begin_scene(job)  # VTK snapshots for ParaView when the job asks for them (--vtk)
         self.owner = {}              # body id -> replica index
         self.shared = False          # several replicas (demlib.replicas.run_batch)
         self.erased_count = 0        # bodies erased so far (invalidates the contacts sorted by replica)
