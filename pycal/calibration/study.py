@@ -113,6 +113,25 @@ class Study:
         self.last_seeds = [used[s] for s in wanted]
         return [results[s] for s in wanted]
 
+    def _drop_missing(self, values, results, rig, response, extra):
+        """Leave out the seeds whose scalar response has no value (NaN: e.g. a pile too flat
+        for any sector to have an angle), with a warning; when more than one in three
+        seeds has none, the point cannot be measured: RunError (a one-parameter stage
+        then backs off from it, as from a point the rig refuses)."""
+        missing = [s for s, v in zip(self.last_seeds, values)
+                   if not isinstance(v, list) and (v is None or math.isnan(v))]
+        if not missing:
+            return values, results
+        where = _fmt_params({k: v for k, v in extra.items() if not k.startswith("rig.")})
+        if len(missing) > max(1, len(values) // 3):
+            raise RunError(f"{rig}: {response.name} has no value on seeds {missing} of {list(self.last_seeds)} "
+                           f"at {where} (the rig ran, the response could not be read: e.g. a pile too flat "
+                           f"for an angle)")
+        self.log(f"  WARNING: {rig}: {response.name} has no value on seed(s) {missing} at {where}; left out")
+        keep = [i for i, s in enumerate(self.last_seeds) if s not in missing]
+        self.last_seeds = [self.last_seeds[i] for i in keep]
+        return [values[i] for i in keep], [results[i] for i in keep]
+
     def run_point(self, material, stage, rig, extra, response, lab_dir, count=None):
         """Values of `response` (pycal.post.responses) at one parameter point: `count` runs
         (default seeds_count) with the material's current overrides + `extra`. A point
@@ -124,6 +143,7 @@ class Study:
         results = self._run_seeds(rig, material, {**self.overrides[material], **extra}, seeds)
         used += self.last_seeds
         values = [response.value(r, lab_dir) for r in results]
+        values, results = self._drop_missing(values, results, rig, response, extra)
         self.point_results.setdefault(key, []).extend(results)
         params = {k: v for k, v in extra.items() if not k.startswith("rig.")}
         for seed, v in zip(self.last_seeds, values):

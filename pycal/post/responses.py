@@ -8,6 +8,7 @@ folder), and which lab-curve plots show a stage's chosen point (by response, not
 rig name). A name that is not listed here is read as a scalar key of result.json
 (e.g. aor_mean_deg); its unit is its name's unit suffix.
 """
+import math
 from dataclasses import dataclass
 from typing import Callable, Optional
 
@@ -29,6 +30,15 @@ class Response:
     @property
     def unit_label(self):
         return UNIT_LABELS.get(self.unit, self.unit)
+
+
+def _scalar(key):
+    """A scalar result key as float; NaN where the result has no value (`null`, e.g. a
+    pile too flat for any sector to have an angle)."""
+    def f(result, lab_dir):
+        v = result[key]
+        return math.nan if v is None else float(v)
+    return f
 
 
 def _friction_targets(result, lab_dir):
@@ -72,9 +82,9 @@ def _log_ratio(result, lab_dir):
 
 
 RESPONSES = {r.name: r for r in [
-    Response("bulk_density_kg_m3", "kg_m3", False, lambda r, lab: float(r["bulk_density_kg_m3"]),
+    Response("bulk_density_kg_m3", "kg_m3", False, _scalar("bulk_density_kg_m3"),
              description="bulk density of the struck cell fill"),
-    Response("aor_mean_deg", "deg", False, lambda r, lab: float(r["aor_mean_deg"]),
+    Response("aor_mean_deg", "deg", False, _scalar("aor_mean_deg"),
              description="angle of repose, mean over the pile's sectors"),
     Response("unloading_stiffness_log_ratio", "log_ratio", False, _log_ratio, _compression_plots,
              "ln(simulated / lab unloading stiffness), mean over the lab steps >= 10 kPa"),
@@ -108,4 +118,4 @@ def get(name):
     unit = unit_of_name(name)
     if unit is None:
         return None
-    return Response(name, unit, False, lambda r, lab: float(r[name]), description=f"result key {name}")
+    return Response(name, unit, False, _scalar(name), description=f"result key {name}")

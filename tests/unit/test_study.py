@@ -478,3 +478,45 @@ def test_calibrate_and_fit_density_commands_run_on_a_fake_executor(tmp_path, stu
     import re
     estimate = float(re.search(r"^M2: particle density (\S+) kg/m3", out, re.M).group(1))
     assert code == 0 and abs(estimate - rho_truth) < 50 and "95 % interval" in out
+
+
+def test_a_pile_too_flat_for_an_angle_is_a_limit_not_a_crash(tmp_path):
+    """Measured on the new law (M3-dry, rolling 0.02): the pile spreads to two layers and no
+    sector has an angle, so aor_mean_deg is null on every seed. The stage must back off
+    from such a point as from a refused one, and still land on the root (the lab's 38 deg
+    at rolling 0.2 in this fake law); a single seed without an angle is left out."""
+    cfg = tmp_path / "flat.yaml"
+    cfg.write_text("""
+name: flat
+seeds_count: 3
+materials:
+  M3-dry:
+    - stage: rolling_resistance
+      rig: aor
+      response: aor_mean_deg
+      target: {sample: fines_dry, test: angle_of_repose, band_deg: 2.0}
+      parameter:
+        keys: [interactions.M3-dry.rolling_resistance_coefficient]
+        start: 0.35
+        bounds: [0.02, 1.5]
+        response_increases: true
+        tolerance_coefficient: 0.1
+      max_runs_count: 45
+""")
+
+    def pile(job):
+        eta = job["materials"]["M3-dry"]["interactions"]["M3-dry"]["rolling_resistance_coefficient"]
+        if eta < 0.1 or (eta < 0.3 and job["seed"] % 3 == 0):
+            return {"aor_mean_deg": None}
+        return {"aor_mean_deg": 30 + 40 * eta}
+
+    logged = []
+    ex = FakeRigs(results={"aor": pile})
+    (row,) = Study(cfg, ex, tmp_path / "out", log=logged.append).run()
+    etas = [j["materials"]["M3-dry"]["interactions"]["M3-dry"]["rolling_resistance_coefficient"] for j in ex.asked]
+    target = labdata.aor_target_deg("fines_dry")
+    p = row["parameters"][0]
+    assert min(etas) < 0.1, "the design should try the low end"
+    assert holds(p, (target - 30) / 40)
+    assert any("refused rolling resistance (M3-dry) = 0.02: it becomes a limit" in m for m in logged)
+    assert any("has no value on seed(s)" in m and "left out" in m for m in logged)
