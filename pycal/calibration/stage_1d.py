@@ -8,7 +8,10 @@
    to every run so far, invert it for the target (estimate, 95 % interval), and run
    the point that most shrinks the interval (pycal.stats.sequential.step_1d).
 A point the rig refuses becomes a limit: the bounds in use end halfway between it and
-the nearest point that ran. The calibrated value is the estimate (4 significant digits).
+the nearest point that ran. When the target then lies beyond that limit, the stage
+probes halfway between the limit and the refused point (a probe that runs moves the limit
+out to it, one refused moves it in), until the gap is below PROBE_GAP_U of the bounds.
+The calibrated value is the estimate (4 significant digits).
 """
 import math
 
@@ -22,6 +25,8 @@ from ..stats.sequential import second_point_u, step_1d
 from . import plots
 from .names import unit_label
 from .study import BudgetSpent
+
+PROBE_GAP_U = 0.02     # bisection towards a refused point stops at this gap (fraction of the bounds)
 
 
 def _slope_per_u(st, scale, x0, y0):
@@ -80,7 +85,26 @@ def run(study, material, st):
             return False
         xs.extend([x] * len(vals))
         ys.extend(vals)
+        u = float(scale.to_unit(x))
+        lo_u, hi_u = min(lo_u, u), max(hi_u, u)     # a probe past a limit ran: the limit moves out to it
         return True
+
+    def probe_past_limit(step):
+        """The target lies beyond a limit set by a refused point: the point halfway between
+        the limit and that refused point (bisection towards what the rig can run), or None
+        when the gap is below PROBE_GAP_U or no refused point lies beyond that limit."""
+        side = {stopping.BEYOND_LOWER: -1, stopping.BEYOND_UPPER: 1}.get(step.stop)
+        if side is None:
+            return None
+        limit = lo_u if side < 0 else hi_u
+        beyond = [float(scale.to_unit(x)) for x, _ in refused]
+        beyond = [u for u in beyond if (u - limit) * side > 0]
+        if not beyond:
+            return None
+        nearest = min(beyond, key=lambda u: abs(u - limit))
+        if abs(nearest - limit) < PROBE_GAP_U:
+            return None
+        return float(scale.from_unit(0.5 * (limit + nearest)))
 
     def decide(runs):
         return step_1d(scale, xs, ys, target.value, p["increasing"],
@@ -122,7 +146,11 @@ def run(study, material, st):
     while True:
         step = decide(runs_left())
         if step.stop:
-            break
+            probe = probe_past_limit(step) if runs_left() >= n else None
+            if probe is None:
+                break
+            study.log(f"  the target lies past the limit a refused point set: probing {p['label']} = {probe:.4g}")
+            step.next_x = probe
         try:
             point(step.next_x)
         except BudgetSpent:

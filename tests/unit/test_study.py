@@ -520,3 +520,40 @@ materials:
     assert holds(p, (target - 30) / 40)
     assert any("refused rolling resistance (M3-dry) = 0.02: it becomes a limit" in m for m in logged)
     assert any("has no value on seed(s)" in m and "left out" in m for m in logged)
+
+
+def test_a_root_between_the_limit_and_a_refused_point_is_found_by_probing(tmp_path):
+    """The M3-dry case of the shipped study on the new law: the lab angle needs rolling ~0.15,
+    the pile has no angle at 0.02, and the first limit (halfway back to the start 0.35) is
+    0.185 - above the root. The stage probes towards the refused point and lands on it."""
+    cfg = tmp_path / "probe.yaml"
+    cfg.write_text("""
+name: probe
+seeds_count: 3
+materials:
+  M3-dry:
+    - stage: rolling_resistance
+      rig: aor
+      response: aor_mean_deg
+      target: {sample: fines_dry, test: angle_of_repose, band_deg: 2.0}
+      parameter:
+        keys: [interactions.M3-dry.rolling_resistance_coefficient]
+        start: 0.35
+        bounds: [0.02, 1.5]
+        response_increases: true
+        tolerance_coefficient: 0.05
+      max_runs_count: 60
+""")
+    target = labdata.aor_target_deg("fines_dry")
+    root = 0.15
+
+    def pile(job):
+        eta = job["materials"]["M3-dry"]["interactions"]["M3-dry"]["rolling_resistance_coefficient"]
+        return {"aor_mean_deg": None if eta < 0.08 else target + 40 * (eta - root)}
+
+    logged = []
+    ex = FakeRigs(results={"aor": pile})
+    (row,) = Study(cfg, ex, tmp_path / "out", log=logged.append).run()
+    p = row["parameters"][0]
+    assert any("probing" in m for m in logged)
+    assert row["met"] and holds(p, root), row["message"]
