@@ -30,14 +30,20 @@ esac
 """
 
 
-@pytest.fixture
-def fake_yade(tmp_path, monkeypatch):
+def install_fake_yade(tmp_path, monkeypatch, script):
+    """`script` as the YADE program ($PYCAL_YADE); returns the file where it logs its runs ($FAKE_COUNT)."""
     exe = tmp_path / "fake-yade"
-    exe.write_text(FAKE_YADE)
+    exe.write_text(script)
     exe.chmod(exe.stat().st_mode | stat.S_IEXEC)
     monkeypatch.setenv("PYCAL_YADE", str(exe))
     count = tmp_path / "count"
     count.write_text("")
     monkeypatch.setenv("FAKE_COUNT", str(count))
+    return count
+
+
+@pytest.fixture
+def fake_yade(tmp_path, monkeypatch):
+    count = install_fake_yade(tmp_path, monkeypatch, FAKE_YADE)
     monkeypatch.setenv("FAKE_MODE", "ok")
     return lambda: len(count.read_text().split())

@@ -2,10 +2,10 @@
 expansion, the executor wrapper and `pycal run --replicas`, with a fake YADE that writes
 a batch result.json the way yade_scripts/demlib/replicas.py does."""
 import json
-import stat
 
 import pytest
 
+from conftest import install_fake_yade
 from pycal import replicas, runner
 from pycal.cli import main
 from pycal.errors import ConfigError, RunError
@@ -44,13 +44,7 @@ json.dump(result, open("result.json", "w"))
 
 @pytest.fixture
 def fake_yade(tmp_path, monkeypatch):
-    exe = tmp_path / "fake-yade"
-    exe.write_text(FAKE_YADE)
-    exe.chmod(exe.stat().st_mode | stat.S_IEXEC)
-    monkeypatch.setenv("PYCAL_YADE", str(exe))
-    count = tmp_path / "count"
-    count.write_text("")
-    monkeypatch.setenv("FAKE_COUNT", str(count))
+    count = install_fake_yade(tmp_path, monkeypatch, FAKE_YADE)
     monkeypatch.delenv("FAKE_FAIL_SEED", raising=False)
     monkeypatch.delenv("FAKE_CRASH", raising=False)
     return lambda: count.read_text().split()

@@ -480,29 +480,35 @@ def test_calibrate_and_fit_density_commands_run_on_a_fake_executor(tmp_path, stu
     assert code == 0 and abs(estimate - rho_truth) < 50 and "95 % interval" in out
 
 
-def test_a_pile_too_flat_for_an_angle_is_a_limit_not_a_crash(tmp_path):
-    """Measured on the new law (M3-dry, rolling 0.02): the pile spreads to two layers and no
-    sector has an angle, so aor_mean_deg is null on every seed. The stage must back off
-    from such a point as from a refused one, and still land on the root (the lab's 38 deg
-    at rolling 0.2 in this fake law); a single seed without an angle is left out."""
-    cfg = tmp_path / "flat.yaml"
-    cfg.write_text("""
-name: flat
+def rolling_study(tmp_path, tolerance, max_runs):
+    """A one-stage study: the M3-dry rolling resistance on the dry fines' AoR, start 0.35."""
+    cfg = tmp_path / "rolling.yaml"
+    cfg.write_text(f"""
+name: rolling
 seeds_count: 3
 materials:
   M3-dry:
     - stage: rolling_resistance
       rig: aor
       response: aor_mean_deg
-      target: {sample: fines_dry, test: angle_of_repose, band_deg: 2.0}
+      target: {{sample: fines_dry, test: angle_of_repose, band_deg: 2.0}}
       parameter:
         keys: [interactions.M3-dry.rolling_resistance_coefficient]
         start: 0.35
         bounds: [0.02, 1.5]
         response_increases: true
-        tolerance_coefficient: 0.1
-      max_runs_count: 45
+        tolerance_coefficient: {tolerance}
+      max_runs_count: {max_runs}
 """)
+    return cfg
+
+
+def test_a_pile_too_flat_for_an_angle_is_a_limit_not_a_crash(tmp_path):
+    """Measured on the new law (M3-dry, rolling 0.02): the pile spreads to two layers and no
+    sector has an angle, so aor_mean_deg is null on every seed. The stage must back off
+    from such a point as from a refused one, and still land on the root (the lab's 38 deg
+    at rolling 0.2 in this fake law); a single seed without an angle is left out."""
+    cfg = rolling_study(tmp_path, tolerance=0.1, max_runs=45)
 
     def pile(job):
         eta = job["materials"]["M3-dry"]["interactions"]["M3-dry"]["rolling_resistance_coefficient"]
@@ -526,24 +532,7 @@ def test_a_root_between_the_limit_and_a_refused_point_is_found_by_probing(tmp_pa
     """The M3-dry case of the shipped study on the new law: the lab angle needs rolling ~0.15,
     the pile has no angle at 0.02, and the first limit (halfway back to the start 0.35) is
     0.185 - above the root. The stage probes towards the refused point and lands on it."""
-    cfg = tmp_path / "probe.yaml"
-    cfg.write_text("""
-name: probe
-seeds_count: 3
-materials:
-  M3-dry:
-    - stage: rolling_resistance
-      rig: aor
-      response: aor_mean_deg
-      target: {sample: fines_dry, test: angle_of_repose, band_deg: 2.0}
-      parameter:
-        keys: [interactions.M3-dry.rolling_resistance_coefficient]
-        start: 0.35
-        bounds: [0.02, 1.5]
-        response_increases: true
-        tolerance_coefficient: 0.05
-      max_runs_count: 60
-""")
+    cfg = rolling_study(tmp_path, tolerance=0.05, max_runs=60)
     target = labdata.aor_target_deg("fines_dry")
     root = 0.15
 

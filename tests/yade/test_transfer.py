@@ -19,7 +19,6 @@ id). Each run takes well under a minute of wall time.
 """
 import math
 import re
-from pathlib import Path
 
 import pytest
 
@@ -28,6 +27,7 @@ from pycal.runner import run_job
 from pycal.vtk_output import with_vtk
 
 from documented import assert_documented
+from vtk_files import vtu_header
 
 pytestmark = pytest.mark.yade
 
@@ -100,14 +100,6 @@ def test_the_plate_carries_the_streams_momentum_and_the_bed(m2):
     assert_documented(res)
 
 
-def _vtu_header(path):
-    head = Path(path).read_bytes()[:6000].decode("latin-1")
-    piece = re.search(r'<Piece NumberOfPoints="\s*(\d+)\s*"\s+NumberOfCells="\s*(\d+)', head)
-    arrays = dict((m.group(1), (float(m.group(2)), float(m.group(3)))) for m in re.finditer(
-        r'Name="(\w+)"[^>]*?RangeMin="\s*([-\d.e+]+)\s*"\s+RangeMax="\s*([-\d.e+]+)', head))
-    return int(piece.group(1)), int(piece.group(2)), arrays
-
-
 def _collection(folder, rig, kind):
     text = (folder / f"{rig}-{kind}.pvd").read_text()
     return [(float(t), folder / f) for t, f in re.findall(r'timestep="([^"]+)"[^>]*file="([^"]+)"', text)]
@@ -123,14 +115,14 @@ def test_vtk_snapshots_hold_the_scene(m2):
     assert times == sorted(times) and times[-1] == pytest.approx(res["provenance"]["simulated_time_s"], abs=1e-9)
     total = SHORT["rig.procedure.feed_time_s"] + SHORT["rig.procedure.holdup_wait_s"]
     assert total / VTK_INTERVAL_S <= len(spheres) <= total / VTK_INTERVAL_S + 2
-    n, _, arrays = _vtu_header(spheres[-1][1])
+    n, _, arrays = vtu_header(spheres[-1][1])
     assert n == res["n_particle_spheres_end"]
     for name in ("radii", "linVelVec", "linVelLen", "materialId", "clumpId"):
         assert name in arrays, name
-    _, cells, _ = _vtu_header(facets[-1][1])
+    _, cells, _ = vtu_header(facets[-1][1])
     assert cells == 1                                   # the plate is one facet
     mid = min(spheres, key=lambda s: abs(s[0] - 0.3))   # mid-feed: the stream is there
-    n_mid, _, arrays = _vtu_header(mid[1])
+    n_mid, _, arrays = vtu_header(mid[1])
     print("mid-feed snapshot", mid, n_mid, arrays["linVelLen"], arrays["radii"])
     assert arrays["radii"] == (0.0125, 0.0125)
     assert 12.3 < arrays["linVelLen"][1] < 12.46       # the stream between window and plate, nothing faster
@@ -159,9 +151,9 @@ def test_a_mixed_set_keeps_its_balance_with_lumps(tmp_path_factory, material, fi
     spheres = _collection(vtk, "transfer", "spheres")
     assert len(spheres) == res["vtk_snapshots_count"] and all(f.is_file() for _, f in spheres)
     mid = min(spheres, key=lambda s: abs(s[0] - 0.2))        # the stream, lumps among it
-    n_mid, _, arrays = _vtu_header(mid[1])
+    n_mid, _, arrays = vtu_header(mid[1])
     print("mid-feed snapshot", mid, n_mid, arrays)
     assert n_mid > 50 and arrays["clumpId"][1] >= 0 and 0.0 <= arrays["materialId"][0] <= arrays["materialId"][1] <= 2.0
-    n_end, _, _ = _vtu_header(spheres[-1][1])
+    n_end, _, _ = vtu_header(spheres[-1][1])
     assert n_end == res["n_particle_spheres_end"]
     assert_documented(res)

@@ -7,7 +7,6 @@ cell (result n_particles), every one of them an M2 sphere of radius 12.5 mm (YAD
 one at the end. The transfer rig's snapshots are checked in test_transfer.py.
 """
 import re
-from pathlib import Path
 
 import pytest
 
@@ -15,17 +14,11 @@ from pycal.jobs import resolve_job
 from pycal.runner import run_job
 from pycal.vtk_output import with_vtk
 
+from vtk_files import vtu_header
+
 pytestmark = pytest.mark.yade
 
 INTERVAL_S = 0.25
-
-
-def _header(path):
-    head = Path(path).read_bytes()[:6000].decode("latin-1")
-    piece = re.search(r'<Piece NumberOfPoints="\s*(\d+)\s*"\s+NumberOfCells="\s*(\d+)', head)
-    arrays = dict((m.group(1), (float(m.group(2)), float(m.group(3)))) for m in re.finditer(
-        r'Name="(\w+)"[^>]*?RangeMin="\s*([-\d.e+]+)\s*"\s+RangeMax="\s*([-\d.e+]+)', head))
-    return int(piece.group(1)), int(piece.group(2)), arrays
 
 
 def test_fill_snapshots_hold_the_struck_cell(tmp_path_factory):
@@ -42,7 +35,7 @@ def test_fill_snapshots_hold_the_struck_cell(tmp_path_factory):
     simulated = res["provenance"]["simulated_time_s"]
     assert simulated / INTERVAL_S <= len(snaps) <= simulated / INTERVAL_S + 2
     assert snaps[0][0] == 0.0 and snaps[-1][0] == pytest.approx(simulated, abs=1e-9)
-    n, _, arrays = _header(snaps[-1][1])
+    n, _, arrays = vtu_header(snaps[-1][1])
     print("last snapshot", snaps[-1], n, arrays)
     assert n == res["n_particles"]
     assert arrays["radii"] == (0.0125, 0.0125)
@@ -50,5 +43,5 @@ def test_fill_snapshots_hold_the_struck_cell(tmp_path_factory):
     assert arrays["linVelLen"][1] < 0.05
     facets = sorted(folder.glob("fill-scene1-facets.*.vtu"))
     assert len(facets) == len(snaps)
-    _, cells, _ = _header(facets[-1])
+    _, cells, _ = vtu_header(facets[-1])
     assert cells == 2 + 2 * 32
