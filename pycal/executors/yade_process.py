@@ -2,6 +2,7 @@
 import os
 import shutil
 import subprocess
+from pathlib import Path
 
 from .. import REPO_ROOT, SCRIPT_DIR
 from ..errors import RunError
@@ -37,6 +38,7 @@ def die_with_parent(cmd):
 
 def run_job(job, runs_dir=DEFAULT_RUNS_DIR, timeout_s=3600):
     """Run one job (or return its cached result). Raises RunError on failure."""
+    runs_dir = Path(runs_dir).resolve()     # YADE runs in the job's folder: a relative path would not hold there
     cached = cached_result(job, runs_dir)
     if cached is not None:
         return cached

@@ -18,6 +18,7 @@ def cfg(tmp_path):
 FAKE_YADE = """#!/bin/sh
 # fake yade: args are -j1 -x -n SCRIPT JOB; behaviour chosen by $FAKE_MODE
 job="$5"
+[ -f "$job" ] || { echo "RIG FAILED: job file $job: cannot read it"; exit 4; }
 echo "fake yade running $4 $job"
 echo run >> "$FAKE_COUNT"
 case "$FAKE_MODE" in

@@ -190,3 +190,15 @@ def test_scheduler_address_forms():
 def test_scheduler_needs_the_dask_executor(tmp_path, capsys):
     rc = main(["run", "fill", "--material", "M2", "--scheduler", "tcp://127.0.0.1:8786", "--out", str(tmp_path)])
     assert rc == 2 and "a scheduler address needs --executor dask (not local)" in capsys.readouterr().err
+
+
+def test_a_relative_runs_folder_works(tmp_path, fake_yade, monkeypatch):
+    """`pycal run ... --out runs-here` (a path relative to where the user stands): YADE runs
+    inside the job's folder, so the job file must be given to it by an absolute path
+    (found by the default sweep: 'job file .../.tmp-.../bench/out/...: cannot read it')."""
+    monkeypatch.chdir(tmp_path)
+    job = resolve_job("fill", "M2", seed=1)
+    (res,) = LocalPool(runs_dir="runs-here", workers=1, progress=False).run([job])
+    assert res["bulk_density_kg_m3"] == 1600.0
+    assert (tmp_path / "runs-here" / "fill" / job["job_id"] / "result.json").is_file()
+
