@@ -157,18 +157,24 @@ def friction_offset(result, quantity="mu_static", min_stress_pa=10000.0, targets
     t = _lab_target(result, quantity, targets)
     sim = compared_values(result, quantity)
     lab_s, lab_v, _, _ = sliding_steps(t)
-    diffs = []
-    for k, s in enumerate(result["stress_pa"]):
-        if s < min_stress_pa:
-            continue
-        lab = interp_log_stress(lab_s, lab_v, s, extrapolate_ratio=0.0)
-        if lab is None:
-            continue
-        diffs.append(sim[k] - lab)
+    diffs = [sim[k] - lab for k, lab in _lab_at_simulated_steps(result, lab_s, lab_v, min_stress_pa)]
     if not diffs:
         raise ValueError(f"{result.get('job_id', result.get('rig'))}: no simulated step at or above "
                          f"{min_stress_pa:g} Pa where the lab cell slides")
     return sum(diffs) / len(diffs)
+
+
+def _lab_at_simulated_steps(result, lab_s, lab_v, min_stress_pa):
+    """[(simulated step index, lab value interpolated in log(stress) at its stress)] for the
+    simulated steps at or above min_stress_pa inside the lab curve's stress range."""
+    out = []
+    for k, s in enumerate(result["stress_pa"]):
+        if s < min_stress_pa:
+            continue
+        lab = interp_log_stress(lab_s, lab_v, s, extrapolate_ratio=0.0)
+        if lab is not None:
+            out.append((k, lab))
+    return out
 
 
 STICKS_ANGLE_DEG = 90.0   # a cell that does not slide up to the max tilt (lab or simulation)
@@ -180,7 +186,6 @@ def friction_angle_offset_deg(result, quantity="mu_static", min_stress_pa=10000.
     continuous through the lab cell's hang-on (the wet fines from ~60 kPa), rises with
     cohesion. The lab angles are interpolated in log(stress) (sticking steps included)
     at the simulated stress; simulated stresses outside the lab range are left out."""
-    from .compression import interp_log_stress
     t = _lab_target(result, quantity, targets)
     sim = compared_values(result, quantity)
     lab_s, lab_a = [], []
@@ -193,12 +198,7 @@ def friction_angle_offset_deg(result, quantity="mu_static", min_stress_pa=10000.
             lab_s.append(s)
             lab_a.append(math.degrees(math.atan(v)))
     diffs = []
-    for k, s in enumerate(result["stress_pa"]):
-        if s < min_stress_pa:
-            continue
-        lab = interp_log_stress(lab_s, lab_a, s, extrapolate_ratio=0.0)
-        if lab is None:
-            continue
+    for k, lab in _lab_at_simulated_steps(result, lab_s, lab_a, min_stress_pa):
         stuck = result["sticks"][k] or sim[k] >= STICKS_MU
         diffs.append((STICKS_ANGLE_DEG if stuck else math.degrees(math.atan(sim[k]))) - lab)
     if not diffs:
