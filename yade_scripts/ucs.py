@@ -13,10 +13,11 @@ servoed through procedure.load_steps_pa (demlib.loading, same rule as CCS).
   (radius D/2 around the axis) / (plate area x z_plate): the bulk under the plate;
 - bottom force = downward force on the table; wall force = 0 (no wall); force balance
   (plate + weight - bottom) / (plate + weight) with the weight of each step (particles
-  that roll off the table are erased, as in the AoR rig).
+  that leave the table are erased, as in the AoR rig: also those squeezed out sideways,
+  which can cross the table edge at several m/s).
 - a free pile carries the plate on a few contacts: if one of them overlaps more than
-  numerics.max_overlap_fraction x radius (the linear law's range; at the start value
-  E = 6e6 Pa this happens at 40 kPa), loading stops there and result.json says so
+  numerics.max_overlap_fraction x radius (M3-wet at its start value E = 2e7 Pa: 0.33 R at
+  40 kPa, past 0.4 R on the way to 60 kPa, seed 1), loading stops there and result.json says so
   (load_stopped_at_pa, load_stop_reason, load_steps_completed_count); the curve holds
   the steps reached. A failure before the first step is still an error.
 Outputs: result.json (per-step arrays), spring_curve.csv, lab_comparison.csv, PNGs.

@@ -57,9 +57,16 @@ def set_velocity(ids, vel):
 
 
 def remove_fallen(scene, below_z):
-    """Erase particles whose centre fell below below_z (m): they rolled off the table
-    and are no longer part of the pile. Returns how many were removed."""
-    gone = [b.id for b in scene.live_spheres() if b.state.pos[2] < below_z]
+    """Erase particles that left the table: centre below below_z (m), or beyond the
+    table's edge (half width of rig geometry, table_half_width) by more than a radius.
+    They are no longer part of the pile; one squeezed out of a loaded pile can leave
+    the edge at several m/s and would reach the domain guard before it drops below
+    below_z. Returns how many were removed."""
+    edge = table_half_width(scene.rig["geometry"]) + scene.radius
+    ox, oy = scene.origin[0], scene.origin[1]
+    gone = [b.id for b in scene.live_spheres()
+            if b.state.pos[2] < below_z
+            or max(abs(b.state.pos[0] - ox), abs(b.state.pos[1] - oy)) > edge]
     if gone:
         scene.remove_spheres(gone)
     return len(gone)
