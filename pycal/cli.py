@@ -33,7 +33,11 @@ def _cmd_validate(args):
 
 def _make_jobs(args):
     from .jobs import parse_set, resolve_job
-    overrides = parse_set(args.set)
+    overrides = {}
+    if args.calibrated:                       # a study's calibrated values first; --set on top
+        from .calibration.calibrated import load_study_overrides, overrides_for_material
+        overrides = overrides_for_material(load_study_overrides(args.calibrated), args.material)
+    overrides.update(parse_set(args.set))
     seeds = list(range(args.seed, args.seed + args.seeds))
     jobs = [resolve_job(args.rig, args.material, overrides, seed=s) for s in seeds]
     if args.vtk is not None:                  # --vtk: snapshots for ParaView (pycal/vtk_output.py)
@@ -123,6 +127,9 @@ def build_parser():
         s.add_argument("--set", action="append", metavar="KEY=VALUE",
                        help="override a material key (e.g. particles.density_kg_m3=3100) or a rig key "
                             "(rig.procedure.lift_speed_m_s=0.01); repeatable")
+        s.add_argument("--calibrated", metavar="STUDY_DIR",
+                       help="take the calibrated values of a study (its output folder, e.g. runs/study/zinc_ore): "
+                            "for a material set, each component's; --set still overrides them")
         s.add_argument("--seed", type=int, default=1, help="random seed of the fill (default 1)")
         s.add_argument("--seeds", type=int, default=1, help="run this many seeds: seed, seed+1, ...")
         s.add_argument("--out", default=str(DEFAULT_RUNS_DIR), help="runs directory (default runs/)")

@@ -330,13 +330,45 @@ def _check_pair_props(c, props, key):
         c.number(coh[pname], f"{key}.cohesion.{pname}", lo, hi)
 
 
+def _take_from_components(c, data, materials):
+    """Apply the set's `from_components` rules in place: each {to: cross_interactions.A.B.<key>,
+    from: <component>, key: <key of that component's config>} copies the component's value
+    (with any override or calibrated value it has) into the cross pair, e.g. the wet fines'
+    fines-wall adhesion into the fines-gravel pair. One rule per value: a calibrated
+    component value reaches the set without being written twice."""
+    rules = data.get("from_components", [])
+    if not isinstance(rules, list):
+        c.fail("from_components", "must be a list of {to, from, key}")
+    comps = data["components"]
+    for i, rule in enumerate(rules):
+        k = f"from_components[{i}]"
+        c.keys(rule, k, ["to", "from", "key"])
+        if rule["from"] not in comps:
+            c.fail(f"{k}.from", f"{rule['from']!r} is not a component ({', '.join(comps)})")
+        to = str(rule["to"]).split(".")
+        if len(to) < 4 or to[0] != "cross_interactions" or to[1] not in comps or to[2] not in comps:
+            c.fail(f"{k}.to", f"{rule['to']!r} must be cross_interactions.<A>.<B>.<property> of two components")
+        node = materials[rule["from"]]
+        for part in str(rule["key"]).split("."):
+            if not isinstance(node, dict) or part not in node:
+                c.fail(f"{k}.key", f"{rule['key']!r}: no such key in configs/materials/{rule['from']}.yaml")
+            node = node[part]
+        pair = data["cross_interactions"].get(to[1], {}).get(to[2])
+        if not isinstance(pair, dict):
+            c.fail(f"{k}.to", f"cross_interactions.{to[1]}.{to[2]} is not in the set (write the pair as A: {{B: ...}})")
+        for part in to[3:-1]:
+            pair = pair.setdefault(part, {})
+        pair[to[-1]] = copy.deepcopy(node)
+
+
 def validate_material_set(data, path, materials):
     """Check one material set mapping. `materials`: {name: validated material config} of
     every known material. Returns the set with `mass_fraction` added to each component
     (mass_percent / sum of the components' mass_percent)."""
     c = _Checker(path)
     c.keys(data, "", ["name", "components", "cross_interactions"],
-           ["description", "lab_sample", "provenance", "assumptions"])
+           ["description", "lab_sample", "provenance", "assumptions", "from_components"])
+    data = copy.deepcopy(data)
     if Path(path).suffix == ".yaml" and data["name"] != Path(path).stem:
         c.fail("name", f"{data['name']!r} must equal the file name {Path(path).stem!r}")
     if data["name"] in materials:
@@ -380,7 +412,7 @@ def validate_material_set(data, path, materials):
             c.fail(f"cross_interactions.{a}", f"not a component ({', '.join(comps)})")
         if not isinstance(partners, dict):
             c.fail(f"cross_interactions.{a}", "must be a mapping partner -> properties")
-        for b, props in partners.items():
+        for b in partners:
             key = f"cross_interactions.{a}.{b}"
             if b not in comps:
                 c.fail(key, f"not a component ({', '.join(comps)})")
@@ -390,12 +422,15 @@ def validate_material_set(data, path, materials):
             if pair in seen:
                 c.fail(key, f"the pair {a} - {b} is listed twice")
             seen.add(pair)
-            _check_pair_props(c, props, key)
     names = list(comps)
     for i, a in enumerate(names):
         for b in names[i + 1:]:
             if frozenset((a, b)) not in seen:
                 c.fail(f"cross_interactions.{a}.{b}", "missing (every pair of two components, once)")
+    _take_from_components(c, data, materials)
+    for a, partners in cross.items():
+        for b, props in partners.items():
+            _check_pair_props(c, props, f"cross_interactions.{a}.{b}")
     out = copy.deepcopy(data)
     for name, comp in out["components"].items():
         comp["mass_fraction"] = comp["mass_percent"] / total

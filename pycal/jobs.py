@@ -101,6 +101,7 @@ def resolve_set_job(rig, set_name, overrides=None, seed=1, config_dir=CONFIG_DIR
     known = {m: copy.deepcopy(load_material(m, config_dir)) for m in material_names(config_dir)}
     comps = list(raw.get("components") or {}) if isinstance(raw.get("components"), dict) else []
     overrides = dict(overrides or {})
+    set_keys = []
     for key, value in overrides.items():
         head = key.split(".", 1)[0]
         if key.startswith("rig."):
@@ -108,7 +109,10 @@ def resolve_set_job(rig, set_name, overrides=None, seed=1, config_dir=CONFIG_DIR
         elif head in comps and "." in key:
             _set_path(known[head], key.split(".", 1)[1], value, f"overrides of configs/materials/{head}.yaml")
         else:
-            _set_path(raw, key, value, f"overrides of {set_path}")
+            set_keys.append(key)
+    for key in set_keys:    # after the components': a set override wins over a from_components rule
+        _own_carried_key(raw, key, known)
+        _set_path(raw, key, overrides[key], f"overrides of {set_path}")
     partners = set(material_names(config_dir)) | set(load_boundaries_cached(config_dir))
     for m in comps:
         if m in known:
@@ -123,6 +127,28 @@ def resolve_set_job(rig, set_name, overrides=None, seed=1, config_dir=CONFIG_DIR
             materials[a]["interactions"][b] = copy.deepcopy(props)
             materials[b]["interactions"][a] = copy.deepcopy(props)
     return _finish_job(rig, rig_cfg, seed, set_name, materials, overrides, config_dir, material_set=mset)
+
+
+def _own_carried_key(raw, key, known):
+    """Before a set override of `key`: a from_components rule that sets `key` (or the
+    subtree holding it) is written into the set's cross pair now and dropped, so that the
+    override replaces the component's value instead of being replaced by it."""
+    rules = raw.get("from_components")
+    if not isinstance(rules, list):
+        return
+    for rule in list(rules):
+        to = str(rule.get("to", ""))
+        if key == to or key.startswith(to + "."):
+            node = known.get(rule.get("from"), {})
+            for part in str(rule.get("key", "")).split("."):
+                node = node.get(part) if isinstance(node, dict) else None
+            parts = to.split(".")
+            pair = raw.get("cross_interactions", {})
+            for part in parts[1:-1]:
+                pair = pair.setdefault(part, {}) if isinstance(pair, dict) else {}
+            if isinstance(pair, dict) and node is not None:
+                pair[parts[-1]] = copy.deepcopy(node)
+            rules.remove(rule)
 
 
 def _finish_job(rig, rig_cfg, seed, material, materials, overrides, config_dir, material_set=None):

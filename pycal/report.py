@@ -142,6 +142,27 @@ def _validation(study_dir, rows):
     return parts
 
 
+def _application(study_dir, rows):
+    """The 'application' section: design runs with the calibrated values (no lab test)."""
+    if not rows:
+        return []
+    parts = ["<h2>Application (design runs with the calibrated values; no lab test behind them)</h2>",
+             "<table><tr><th>run</th><th>response</th><th>seed mean +- SD (n)</th></tr>"]
+    for r in rows:
+        head = f"{_esc(r['name'])} ({_esc(r['material'])}, {_esc(r['rig'])})"
+        if r.get("error"):
+            parts.append(f"<tr><td>{head}</td><td colspan=2>runs failed: {_esc(r['error'])}</td></tr>")
+            continue
+        for s in r["responses"]:
+            value = (f"{s['true_count']} of {s['n']} seeds" if s["kind"] == "flag"
+                     else f"{_num(s['mean'])} +- {_num(s['sd'])} ({s['n']})")
+            parts.append(f"<tr><td>{head}</td><td>{_esc(s['response'])}</td><td class=num>{value}</td></tr>")
+    parts.append("</table>")
+    plots = sorted({r["plot"] for r in rows if r.get("plot")})
+    parts += [_img(study_dir, p) for p in plots if (study_dir / p).is_file()]
+    return parts
+
+
 def write_report(study_dir):
     """Write <study_dir>/report.html from summary.json and the plots; returns its path."""
     study_dir = Path(study_dir)
@@ -170,6 +191,7 @@ def write_report(study_dir):
     parts.append("</table><h2>Stages</h2>")
     parts += [_stage_detail(study_dir, s) for s in stages if s["kind"] != "inherit"]
     parts += _validation(study_dir, summary.get("predicted") or [])
+    parts += _application(study_dir, summary.get("applied") or [])
     parts.append("<h2>Calibrated material files</h2>")
     for mat, ov in summary["overrides"].items():
         iv = summary.get("intervals", {}).get(mat, {})

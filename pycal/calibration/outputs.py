@@ -76,6 +76,7 @@ def write_all(study):
                                   "responses": [x.get("response") for x in r.get("responses", [])]}
                                  for r in study.stage_rows if r["kind"] != "inherit"],
                "predicted": getattr(study, "validation_rows", []),
+               "applied": getattr(study, "application_rows", []),
                "stages": study.stage_rows, "history": study.points,
                "runs": study.runs, "overrides": study.overrides, "intervals": study.intervals,
                "runs_requested": study.runs_requested, "elapsed_s": time.time() - study.t0,

@@ -52,6 +52,7 @@ class Study:
         self.intervals = {m: {} for m in self.cfg["materials"]}   # key -> (estimate, low, high) found so far
         self.stage_rows, self.points, self.runs = [], [], []
         self.validation_rows = []    # predictions of tests the calibration never saw (validation.py)
+        self.application_rows = []   # design runs with the calibrated values (application.py)
         self.runs_requested = 0
         self.yade_versions = set()
         self.point_results = {}      # (material, stage, rig, point json) -> results of that point
@@ -266,6 +267,9 @@ class Study:
                 outputs.write_all(self)
         from . import validation
         self.validation_rows = validation.run(self)      # predictions with the calibrated values
+        outputs.write_all(self)
+        from . import application
+        self.application_rows = application.run(self)    # design runs with the calibrated values
         outputs.write_all(self)
         return self.stage_rows
 

@@ -244,10 +244,13 @@ def load_study(path):
     c = _Checker(path)
     _check_removed(c, data, "")
     c.keys(data, "", ["name", "materials", "seeds_count"], ["description", "max_runs_count", "design_case",
-                                                            "validation"])
+                                                            "validation", "application"])
     if "validation" in data:
         from . import validation
         validation.check(data["validation"], c)
+    if "application" in data:
+        from . import application
+        application.check(data["application"], c)
     c.string(data["name"], "name")
     seeds = int(c.number(data["seeds_count"], "seeds_count", 1))
     if "max_runs_count" in data:

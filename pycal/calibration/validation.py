@@ -13,8 +13,6 @@ compares responses with the lab, with the seed spread:
           material: mixed-dry                 # a set: its components take their calibrated values
           rig_overrides: {rig.procedure.lift_speed_m_s: 0.01}
           sensitivity: true                   # if it misses: which calibrated value drives it
-          carry:                              # set keys that take a calibrated value of a component
-            - {to: cross_interactions.M2.M3-wet.cohesion, from: M3-wet, key: interactions.steel.cohesion}
           compare:
             - {response: aor_left_deg, lab: {table: angle_of_repose, sample: sample50_dry, column: left_deg},
                band_deg: 2.0}
@@ -27,7 +25,6 @@ one (`sensitivity: true`, settings in the section): each calibrated parameter of
 change of the first missed response per parameter, largest first ("what drives it").
 Outputs: <study>/validation.csv, validation.json, plots/validation-<name>.png.
 """
-import copy
 import json
 import math
 from pathlib import Path
@@ -58,7 +55,7 @@ def check(section, c, key="validation"):
     names = set()
     for i, p in enumerate(preds):
         k = f"{key}.predictions[{i}]"
-        c.keys(p, k, ["name", "rig", "material", "compare"], ["rig_overrides", "carry", "sensitivity"])
+        c.keys(p, k, ["name", "rig", "material", "compare"], ["rig_overrides", "sensitivity"])
         if p.get("sensitivity") and "sensitivity" not in section:
             c.fail(f"{k}.sensitivity", "needs the section's sensitivity settings (validation.sensitivity)")
         if p["name"] in names:
@@ -75,8 +72,6 @@ def check(section, c, key="validation"):
                 c.keys(lab, f"{ck}.lab", ["table", "sample", "column"])
                 if len(bands) != 1:
                     c.fail(ck, "a scalar comparison needs one band_<unit> (the lab value's band)")
-        for j, cr in enumerate(p.get("carry", [])):
-            c.keys(cr, f"{k}.carry[{j}]", ["to", "from", "key"])
 
 
 def lab_value(spec):
@@ -91,48 +86,8 @@ def lab_value(spec):
 
 def overrides_for(study, pred):
     """Job overrides carrying the calibrated values into the prediction's material (set)."""
-    from ..configs import material_set_names
-    material = pred["material"]
-    out = dict(pred.get("rig_overrides", {}))
-    if material in material_set_names():
-        from ..configs import load_material_set
-        comps = load_material_set(material)["components"]
-        for m in comps:
-            for k, v in study.overrides.get(m, {}).items():
-                head = k.split(".")
-                # a pair with another component is the set's cross_interactions (carry moves values there)
-                if head[0] == "interactions" and head[1] in comps and head[1] != m:
-                    continue
-                out[f"{m}.{k}"] = v
-        for cr in pred.get("carry", []):
-            src = study.overrides.get(cr["from"], {})
-            value = _value_at(src, cr["key"], cr["from"])
-            out[cr["to"]] = copy.deepcopy(value)
-    else:
-        out.update(study.overrides.get(material, {}))
-    return out
-
-
-def _value_at(overrides, key, material):
-    """The calibrated value of `key`: its override (a whole subtree set by a stage) or the
-    config's, with the overrides of its leaves applied in order."""
-    if key in overrides:
-        node = copy.deepcopy(overrides[key])
-    else:
-        from ..configs import load_material
-        node = copy.deepcopy(load_material(material))
-        for part in key.split("."):
-            node = node[part]
-    if not isinstance(node, dict):
-        return node
-    prefix = key + "."
-    for k, v in overrides.items():
-        if k.startswith(prefix):
-            sub, parts = node, k[len(prefix):].split(".")
-            for part in parts[:-1]:
-                sub = sub[part]
-            sub[parts[-1]] = v
-    return node
+    from .calibrated import overrides_for_material
+    return dict(pred.get("rig_overrides", {}), **overrides_for_material(study.overrides, pred["material"]))
 
 
 def compare_results(results, cmp):

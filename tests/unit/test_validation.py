@@ -105,14 +105,32 @@ def test_a_scalar_comparison_needs_one_band(tmp_path):
         load_study(p)
 
 
-def test_carry_takes_a_subtree_with_its_calibrated_leaves():
-    """A stage switched the fines-steel pair to hysteretic (`set:`) and a later stage moved its
-    pressure_fraction: the carried value is the switched pair with the moved leaf."""
-    from pycal.calibration.validation import _value_at
-    overrides = {"interactions.steel.cohesion": {"model": "hysteretic", "force_fraction": 0.0,
-                                                 "pressure_fraction": 0.0, "update_interval_s": 0.01},
-                 "interactions.steel.cohesion.pressure_fraction": 0.012}
-    got = _value_at(overrides, "interactions.steel.cohesion", "M3-wet")
-    assert got == {"model": "hysteretic", "force_fraction": 0.0, "pressure_fraction": 0.012, "update_interval_s": 0.01}
-    # no override: the config's own value
-    assert _value_at({}, "interactions.steel.cohesion", "M3-wet")["model"] == "force_fraction"
+def test_a_calibrated_subtree_with_its_leaves_reaches_the_sets_cross_pairs():
+    """A stage switched the fines-steel pair to hysteretic (a whole subtree) and a later stage
+    moved its pressure_fraction: through the set's from_components rules the wet fines'
+    pairs with gravel and lumps get the switched pair with the moved leaf."""
+    from pycal.calibration.calibrated import overrides_for_material
+    from pycal.jobs import resolve_job
+    study = {"M3-wet": {"interactions.steel.cohesion": {"model": "hysteretic", "force_fraction": 0.0,
+                                                        "pressure_fraction": 0.0, "update_interval_s": 0.01},
+                        "interactions.steel.cohesion.pressure_fraction": 0.012,
+                        "interactions.M3-wet.friction_coefficient": 0.41,
+                        "interactions.M2.friction_coefficient": 0.99}}   # a pair inside the set: not applied
+    job = resolve_job("aor_mixed", "mixed-wet", overrides_for_material(study, "mixed-wet"))
+    want = {"model": "hysteretic", "force_fraction": 0.0, "pressure_fraction": 0.012, "update_interval_s": 0.01}
+    for coarse in ("M1", "M2"):
+        pair = job["materials"][coarse]["interactions"]["M3-wet"]
+        assert pair["cohesion"] == want and pair["friction_coefficient"] == 0.41
+        assert job["materials"]["M3-wet"]["interactions"][coarse] == pair
+    # no calibrated value: the shipped fines-wall adhesion
+    job0 = resolve_job("aor_mixed", "mixed-wet")
+    assert job0["materials"]["M2"]["interactions"]["M3-wet"]["cohesion"] == \
+        job0["materials"]["M3-wet"]["interactions"]["steel"]["cohesion"]
+
+
+def test_a_set_override_wins_over_the_component_value_it_would_take():
+    from pycal.jobs import resolve_job
+    job = resolve_job("aor_mixed", "mixed-wet", {"cross_interactions.M2.M3-wet.cohesion.force_fraction": 1.0,
+                                                 "M3-wet.interactions.steel.cohesion.force_fraction": 0.2})
+    assert job["materials"]["M2"]["interactions"]["M3-wet"]["cohesion"]["force_fraction"] == 1.0
+    assert job["materials"]["M1"]["interactions"]["M3-wet"]["cohesion"]["force_fraction"] == 0.2
