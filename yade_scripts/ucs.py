@@ -19,14 +19,16 @@ servoed through procedure.load_steps_pa (demlib.loading, same rule as CCS).
   numerics.max_overlap_fraction x radius (M3-wet at its start value E = 2e7 Pa: 0.33 R at
   40 kPa, past 0.4 R on the way to 60 kPa, seed 1), loading stops there and result.json says so
   (load_stopped_at_pa, load_stop_reason, load_steps_completed_count); the curve holds
-  the steps reached. A failure before the first step is still an error.
+  the steps reached. The same when the pile cannot hold a step at rest within
+  max_settle_time_s (it keeps creeping under the plate: the free pile yields; M2 seed 5 at
+  90 kPa). A failure before the first step is still an error.
 Outputs: result.json (per-step arrays), spring_curve.csv, lab_comparison.csv, PNGs.
 A batch job (several seeds) builds one rig per seed side by side (demlib.replicas).
 Run: yade -j1 -x -n yade_scripts/ucs.py job.json
 """
 import math
 
-from yade_scripts.demlib.jobio import run_rig, OverlapLimitExceeded
+from yade_scripts.demlib.jobio import run_rig, NoRestUnderLoad, OverlapLimitExceeded
 from yade_scripts.demlib import rigs, loading, compression, replicas
 
 PLATE_SEGMENTS = 32   # polygon of the circular plate (equal area: the stress area is exact)
@@ -63,9 +65,10 @@ def procedure(scene, out_dir):
     for target in p["load_steps_pa"]:
         try:
             yield from rec.step(target, "loading")
-        except OverlapLimitExceeded as exc:
+        except (OverlapLimitExceeded, NoRestUnderLoad) as exc:
             # the few plate contacts of a free pile exceed the contact law's overlap range
-            # before this stress: the curve ends at the last step reached (stated in result.json)
+            # before this stress, or the pile cannot stand still under it (it yields): the
+            # curve ends at the last step reached (stated in result.json)
             if not rec.data["stress_pa"]:
                 raise
             stop = {"load_stopped_at_pa": target, "load_stop_reason": str(exc)}

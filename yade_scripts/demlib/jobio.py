@@ -28,6 +28,12 @@ class RigFailure(Exception):
     """The rig cannot give a valid result (blow-up, escape, no rest...)."""
 
 
+class NoRestUnderLoad(RigFailure):
+    """A load step's stress is not held with the bulk at rest in the allowed time. In a
+    confined cell that is a failure; a free pile (UCS) that cannot stand still under a
+    load has yielded, and the UCS rig ends its curve there."""
+
+
 class OverlapLimitExceeded(RigFailure):
     """A contact overlaps more than numerics.max_overlap_fraction x radius: the contact
     law is outside its range (or particles pass through each other). Rigs that can stop

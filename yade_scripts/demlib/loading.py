@@ -64,7 +64,7 @@ import math
 from yade import O, utils
 from yade import Vector3
 
-from .jobio import RigFailure
+from .jobio import NoRestUnderLoad, RigFailure
 from .phases import steps_of
 
 
@@ -265,7 +265,7 @@ def load_to(scene, plate, stress_pa, tolerance_ratio, max_time_s=None, every=Non
                    f"moving {plate.velocity:.3g} m/s, {plate.n_contacts()} plate contacts, kinetic energy ratio "
                    f"{scene.kinetic_energy_ratio():.3g}, unbalanced force ratio {scene.unbalanced_force_ratio():.3g})")
             plate.hold()
-            raise RigFailure(msg)
+            raise NoRestUnderLoad(msg)
 
 
 def release(scene, plate, clearance_m, max_time_s=None):
