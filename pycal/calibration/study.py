@@ -196,6 +196,18 @@ class Study:
         return self.journal.stage(f"{material}/{st['label']}",
                                   fingerprint(st, self.seeds, sorted(self.overrides[material].items()), tg))
 
+    def _stage_cost(self, material, st, elapsed_s, simulated_count):
+        """(runs simulated, wall time s) of a stage over every process that worked on it:
+        a resumed study replays a stage's runs from the cache in seconds, so each process
+        adds its own share to the stage's journal entry (a killed process's share is lost)."""
+        entry = self.journal.data.get(f"{material}/{st['label']}")
+        if entry is None:                       # a stage with no journal (inherit, or failed at its start)
+            return simulated_count, elapsed_s
+        entry["elapsed_s"] = entry.get("elapsed_s", 0.0) + elapsed_s
+        entry["runs_simulated"] = entry.get("runs_simulated", 0) + simulated_count
+        self.journal.save()
+        return entry["runs_simulated"], entry["elapsed_s"]
+
     def set_value(self, material, keys, value, interval=None):
         """Carry a calibrated value (and its (estimate, low, high)) into the next stages."""
         for k in keys:
@@ -252,10 +264,11 @@ class Study:
                         # the start point cannot run (or no budget is left): the stage is not
                         # met, the study goes on with the values found so far
                         row = failed_row(self, material, st, exc)
+                simulated, elapsed = self._stage_cost(material, st, time.time() - t_stage,
+                                                      getattr(self.executor, "simulated_count", 0) - simulated_before)
                 row.update({"material": material, "stage": st["label"], "kind": st["kind"],
                             "runs_requested": self.runs_requested - runs_before,
-                            "runs_simulated": getattr(self.executor, "simulated_count", 0) - simulated_before,
-                            "elapsed_s": round(time.time() - t_stage, 1)})
+                            "runs_simulated": simulated, "elapsed_s": round(elapsed, 1)})
                 row.setdefault("plots", [])
                 self.stage_rows.append(row)
                 for p in row["parameters"]:

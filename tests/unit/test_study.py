@@ -138,6 +138,20 @@ def test_a_resumed_study_asks_for_the_same_jobs_and_simulates_none(tmp_path, stu
     assert [r["parameters"] for r in rows1] == [r["parameters"] for r in rows2]
 
 
+def test_a_resumed_study_keeps_each_stages_simulated_runs_and_time(tmp_path, study_file):
+    """Resumed in the same folder, every run comes from the cache: the stage rows still
+    give the runs the first process simulated and its time, not zero."""
+    cache = {}
+    rows1 = by_stage(Study(study_file, FakeRigs(cache=cache), tmp_path / "out", log=quiet).run())
+    again = FakeRigs(cache=cache)
+    rows2 = by_stage(Study(study_file, again, tmp_path / "out", log=quiet).run())
+    assert again.simulated_count == 0
+    for name, r1 in rows1.items():
+        assert rows2[name]["runs_simulated"] == r1["runs_simulated"]
+        assert rows2[name]["elapsed_s"] >= r1["elapsed_s"]
+    assert sum(r["runs_simulated"] for r in rows2.values()) > 0
+
+
 def test_seed_base_moves_every_seed_and_gives_an_independent_calibration(tmp_path, study_file):
     a, b = FakeRigs(), FakeRigs()
     rows_a = by_stage(Study(study_file, a, tmp_path / "a", log=quiet, seed_base=1).run())
