@@ -13,7 +13,9 @@ pass over rolling resistance and particle density (AoR and bulk density: two rig
 Reported per parameter: estimate (posterior median), 95 % interval, and the
 correlation matrix. A point the rig refuses is not asked again, nor anything closer to
 it than half its distance to the nearest point that ran (in u); a refused first step
-is tried the other way once.
+is tried the other way once. A refused start point (e.g. the final pass starts where the
+pile is too flat for an angle, after a friction stage lowered the friction) does not end
+the stage: its first steps go on, and the stage fails only when none of them runs.
 """
 import math
 
@@ -70,8 +72,6 @@ def run(study, material, st):
                 widths[j] = widths[j] or len(vals[0])
                 cols.append([[math.nan if v is None else float(v) for v in row] for row in vals])
         except RunError as exc:
-            if not X:
-                raise
             refused.append((xs, str(exc)))
             study.log(f"  the rig refused {xs}: no point near it is asked again")
             return False
@@ -86,11 +86,12 @@ def run(study, material, st):
           min(max(study.current_value(material, p["keys"][0]), p["bounds"][0]), p["bounds"][1]) for p in params]
     if not X and not refused:
         point(x0)
-    targets = [t.value for t, w in zip(tgts, widths) for _ in range(w)]       # one per output
-    ses = [t.standard_error for t, w in zip(tgts, widths) for _ in range(w)]
     tols = [(p["tolerance"], p["tolerance_is_percent"]) for p in params]
 
     def decide(runs):
+        # one target per output (a vector response has several), known once a point ran
+        targets = [t.value for t, w in zip(tgts, widths) for _ in range(w)]
+        ses = [t.standard_error for t, w in zip(tgts, widths) for _ in range(w)]
         return step_nd(scales, X, Y, targets, ses, tols, runs_left=runs, runs_per_point=per_point,
                        avoid_x=[x for x, _ in refused])
 
@@ -99,10 +100,12 @@ def run(study, material, st):
         for k, v in jr.result.items():                    # the values carried before, exactly
             setattr(step, k, v)
     else:
-        u0 = [float(s.to_unit(x)) for s, x in zip(scales, x0)]
-        try:
+        def first_steps(base):
+            """One step per parameter from base (a tenth of the bounds, inwards; a refused
+            step is tried the other way once)."""
+            u0 = [float(s.to_unit(x)) for s, x in zip(scales, base)]
             for j in range(len(params)):
-                for sign in ((1, -1) if u0[j] <= 0.5 else (-1, 1)):     # refused: the other way once
+                for sign in ((1, -1) if u0[j] <= 0.5 else (-1, 1)):
                     u = list(u0)
                     u[j] = min(1.0, max(0.0, u[j] + sign * FIRST_STEP_U))
                     xs = [round_significant(float(s.from_unit(v))) for s, v in zip(scales, u)]
@@ -112,6 +115,13 @@ def run(study, material, st):
                         continue
                     if point(xs):
                         break
+
+        try:
+            first_steps(x0)
+            if not X:
+                raise RunError(f"no point of the first design ran: {refused[0][1]}")
+            if len({tuple(x) for x in X}) < 2:            # the start was refused: steps from what ran
+                first_steps(X[0])
             while True:
                 step = decide(runs_left())
                 if step.stop:

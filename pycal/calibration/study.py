@@ -25,7 +25,7 @@ from ..post import responses as responses_mod
 from ..stats import stopping
 from . import outputs, targets
 from .journal import Journal, fingerprint
-from .names import group_label
+from .names import group_label, unit_of_key
 from .study_config import load_study
 
 
@@ -228,6 +228,19 @@ class Study:
         if row is None or len(params) != 1 or not math.isfinite(params[0]["estimate"]):
             why = ("ran no stage called so" if row is None else
                    "has several parameters: name one with from.key" if len(params) > 1 else "found no value")
+            carried = self.overrides.get(src["material"], {}).get(src.get("key"))
+            if row is not None and len(params) <= 1 and isinstance(carried, (int, float)):
+                # the stage failed, but an earlier stage of the source calibrated the key: that
+                # value (the one the source material carries now) beats the config's guess
+                lo_hi = self.intervals.get(src["material"], {}).get(src["key"], (carried, math.nan, math.nan))
+                self.set_value(material, st["keys"], carried, lo_hi)
+                p = {"label": group_label(st["keys"]), "keys": list(st["keys"]), "estimate": carried,
+                     "low": lo_hi[1], "high": lo_hi[2], "tolerance": math.nan,
+                     "unit": unit_of_key(st["keys"][0]) or "", "scale": "linear",
+                     "band_low": math.nan, "band_high": math.nan}
+                return {**base, "parameters": [p], "stop_reason": "inherited from an earlier stage",
+                        "message": f"{src['material']} {src['stage']} {why}: took the value {src['material']} "
+                                   f"carries from an earlier stage ({carried:.4g}), not met"}
             return {**base, "stop_reason": "not inherited",
                     "message": f"{src['material']} {src['stage']} {why} (the config value is kept)"}
         p = params[0]

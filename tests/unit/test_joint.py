@@ -109,6 +109,22 @@ def test_joint_stage_over_two_rigs_rolling_resistance_and_density(tmp_path):
     assert row["responses"][1]["target_source"] == "lab gravel_dry bulk density"
 
 
+def test_a_start_point_without_a_response_does_not_end_the_stage(tmp_path):
+    """Found in the shipped study: after the friction stage lowered the fines' friction to
+    0.11, the final pass's start (rolling 0.10) gave piles too flat for an angle on every
+    seed and the stage ended there. Fake: no angle below rolling 0.15; the truth lies above."""
+    cfg = tmp_path / "final.yaml"
+    cfg.write_text(ROLLING_DENSITY.replace("          bounds: [0.02, 1.5]", "          start: 0.1\n          bounds: [0.02, 1.5]"))
+    from fake_rigs import aor_law
+    ex = FakeRigs(results={"aor": lambda j: {"aor_mean_deg": aor_law(j) if j["materials"]["M2"]["interactions"]["M2"]
+                                             ["rolling_resistance_coefficient"] >= 0.15 else float("nan")}})
+    (row,) = Study(cfg, ex, tmp_path / "out", log=quiet).run()
+    eta_truth = (labdata.aor_target_deg("gravel_dry") - 20) / 40
+    eta, rho = row["parameters"]
+    assert "the rig refused" in row["message"] and eta_truth > 0.15
+    assert holds(eta, eta_truth) and abs(eta["estimate"] - eta_truth) < 0.05
+
+
 def test_a_refused_point_is_not_asked_again_and_the_fit_goes_on(tmp_path):
     """The rig blows up above fines-steel friction 0.6: the first step of the design goes
     there (0.5 + a fifth of the bounds); the stage must carry on without it."""

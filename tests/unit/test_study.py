@@ -359,6 +359,39 @@ def test_a_stage_whose_start_point_fails_is_not_met_and_the_study_goes_on(tmp_pa
     assert ("M3-wet", "cohesion") in rows
 
 
+def test_inheriting_from_a_failed_stage_takes_the_sources_earlier_value(tmp_path):
+    """Found in the shipped study: the dry fines' final pass failed at its start, and the wet
+    fines kept their config rolling resistance (0.35) instead of the dry fines' calibrated
+    one from the earlier rolling stage."""
+    second = """    - stage: rolling_resistance
+      name: rolling_again
+      rig: aor
+      rig_overrides: {rig.procedure.lift_speed_m_s: 0.05}
+      response: aor_mean_deg
+      target: {sample: fines_dry, test: angle_of_repose, band_deg: 1.0}
+      parameter:
+        keys: [interactions.M3-dry.rolling_resistance_coefficient]
+        bounds: [0.05, 1.5]
+        response_increases: true
+        tolerance_coefficient: 0.02
+      max_runs_count: 24
+  M3-wet:
+    - stage: inherit
+      from: {material: M3-dry, stage: rolling_again, key: interactions.M3-dry.rolling_resistance_coefficient}
+"""
+    cfg = tmp_path / "s.yaml"
+    cfg.write_text(STUDY.replace("  M3-wet:\n    - stage: inherit\n      from: {material: M3-dry, stage: rolling_resistance}\n",
+                                 second))
+    ex = FakeRigs(refuse=lambda j: "no angle" if j["rig_config"]["procedure"].get("lift_speed_m_s") == 0.05 else None)
+    study = Study(cfg, ex, tmp_path / "out", log=quiet)
+    rows = by_stage(study.run())
+    assert rows[("M3-dry", "rolling_again")]["stop_reason"] == "runs failed"
+    found = rows[("M3-dry", "rolling_resistance")]["parameters"][0]["estimate"]
+    inh = rows[("M3-wet", "inherit")]
+    assert inh["parameters"][0]["estimate"] == found != 0.35 and not inh["met"]
+    assert study.overrides["M3-wet"]["interactions.M3-wet.rolling_resistance_coefficient"] == found
+
+
 def test_a_target_beyond_the_bounds_is_reported_not_forced(tmp_path, study_file):
     cfg = tmp_path / "short.yaml"
     cfg.write_text(STUDY.replace("bounds: [0.05, 1.5]", "bounds: [0.05, 0.3]").replace("start: 0.35", "start: 0.2"))
