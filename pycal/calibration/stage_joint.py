@@ -75,9 +75,12 @@ def run(study, material, st):
             refused.append((xs, str(exc)))
             study.log(f"  the rig refused {xs}: no point near it is asked again")
             return False
-        for i in range(n):
+        # a seed without a value (e.g. a pile too flat for an angle, left out by run_point)
+        # is a NaN row of that response: each output's model uses its own finite rows
+        rows = max(len(c) for c in cols)
+        for i in range(rows):
             X.append(xs)
-            Y.append([v for c in cols for v in c[i]])
+            Y.append([v for c, w in zip(cols, widths) for v in (c[i] if i < len(c) else [math.nan] * w)])
         return True
 
     while (xs := jr.next_recorded()) is not None:        # a resumed study: the same points again

@@ -116,8 +116,11 @@ def test_a_start_point_without_a_response_does_not_end_the_stage(tmp_path):
     cfg = tmp_path / "final.yaml"
     cfg.write_text(ROLLING_DENSITY.replace("          bounds: [0.02, 1.5]", "          start: 0.1\n          bounds: [0.02, 1.5]"))
     from fake_rigs import aor_law
-    ex = FakeRigs(results={"aor": lambda j: {"aor_mean_deg": aor_law(j) if j["materials"]["M2"]["interactions"]["M2"]
-                                             ["rolling_resistance_coefficient"] >= 0.15 else float("nan")}})
+    def aor(j):      # no angle below rolling 0.15; between 0.15 and 0.3, none on seed 2 (one seed left out)
+        eta = j["materials"]["M2"]["interactions"]["M2"]["rolling_resistance_coefficient"]
+        flat = eta < 0.15 or (eta < 0.3 and j["seed"] == 2)
+        return {"aor_mean_deg": float("nan") if flat else aor_law(j)}
+    ex = FakeRigs(results={"aor": aor})
     (row,) = Study(cfg, ex, tmp_path / "out", log=quiet).run()
     eta_truth = (labdata.aor_target_deg("gravel_dry") - 20) / 40
     eta, rho = row["parameters"]
