@@ -57,6 +57,16 @@ def ucs(job):
             "bulk_density_kg_m3": [2750 - 1149 * math.exp(-s / 150000) for s in stress]}
 
 
+def transfer(job):
+    """The transfer chute (application): impact stress 1e5 Pa x the gravel-fines friction of
+    the set (a cross pair the set takes from the fines), design 88.6 kPa, wet fines plug."""
+    fines = next(m for m in job["materials"] if m.startswith("M3"))
+    mu = job["materials"]["M2"]["interactions"][fines]["friction_coefficient"]
+    return {"impact_stress_pa": 1e5 * mu, "design_impact_stress_pa": 88600.0, "momentum_flux_stress_pa": 41800.0,
+            "throughput_in_kg_s": 52.0, "throughput_out_kg_s": 51.0, "holdup_mass_kg": 0.1,
+            "plugged": fines == "M3-wet"}
+
+
 def wall(steel, s):
     coh = steel["cohesion"]
     return steel["friction_coefficient"] + (3e-4 * coh.get("pressure_fraction", 0.0) * s
@@ -76,7 +86,7 @@ def test_the_shipped_study_runs_every_stage_on_fake_rigs(tmp_path, fake_stiffnes
         stresses = job["rig_config"]["procedure"]["consolidation_stresses_pa"]
         return wall_result(wall, stresses=tuple(stresses))(job)
     ex = FakeRigs(results={"ccs_expansion": stiffness, "internal_friction": internal, "wall_friction": wall_rig,
-                           "aor_mixed": mixed_pile, "surcharge": surcharge, "ucs": ucs},
+                           "aor_mixed": mixed_pile, "surcharge": surcharge, "ucs": ucs, "transfer": transfer},
                   noise={"fake_log_ratio": 0.03})
     study = Study(DEFAULT_STUDY, ex, tmp_path / "out", log=lambda m: None, seed_base=7)
     rows = study.run()
@@ -103,5 +113,10 @@ def test_the_shipped_study_runs_every_stage_on_fake_rigs(tmp_path, fake_stiffnes
     assert all(j["seed"] >= 7 for j in ex.asked if j["rig"] == "aor_mixed")
     fines = next(r for r in study.validation_rows if r["prediction"] == "fines_dry_ucs")
     assert fines["comparisons"][0]["n"] > 0 and fines["comparisons"][0]["inside"]
+    # application: the transfer dry and wet on the calibrated fines' friction
+    dry_t, wet_t = study.application_rows
+    mu = study.overrides["M3-dry"]["interactions.M3-dry.friction_coefficient"]
+    assert dry_t["responses"][0]["mean"] == pytest.approx(1e5 * mu)
+    assert (wet_t["responses"][-1]["true_count"], dry_t["responses"][-1]["true_count"]) == (3, 0)
     html = write_report(study.out).read_text()
-    assert "YADE 2023.02a-fake" in html and "rolling_density_final" in html
+    assert "YADE 2023.02a-fake" in html and "rolling_density_final" in html and "Application (design runs" in html
