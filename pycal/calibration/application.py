@@ -23,7 +23,7 @@ from ..errors import RunError
 from ..files import finite, write_csv, write_json
 from ..post import mean_std
 from ..plotting import new_figure, save_png
-from .calibrated import overrides_for_material
+from .calibrated import run_overrides
 
 
 def check(section, c, key="application"):
@@ -63,11 +63,11 @@ def run(study):
     section = study.cfg.get("application")
     if not section:
         return []
-    seeds = list(range(study.seed_base, study.seed_base + int(section.get("seeds_count", len(study.seeds)))))
+    seeds = study.seeds_from_base(section.get("seeds_count", len(study.seeds)))
     rows = []
     for spec in section["runs"]:
         study.log(f"[application] {spec['name']}: {spec['rig']} on {spec['material']} with the calibrated values")
-        extra = dict(spec.get("rig_overrides", {}), **overrides_for_material(study.overrides, spec["material"]))
+        extra = run_overrides(study.overrides, spec)
         row = {"name": spec["name"], "rig": spec["rig"], "material": spec["material"], "responses": [],
                "seeds": [], "error": None, "plot": None}
         try:

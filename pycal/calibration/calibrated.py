@@ -31,6 +31,12 @@ def overrides_for_material(study_overrides, material):
     return out
 
 
+def run_overrides(study_overrides, spec):
+    """Job overrides of a run after the calibration (a validation prediction or an
+    application run): its rig_overrides and the calibrated values of its material (set)."""
+    return dict(spec.get("rig_overrides", {}), **overrides_for_material(study_overrides, spec["material"]))
+
+
 def load_study_overrides(study_dir):
     """The calibrated overrides {material: {key: value}} of a study output folder
     (<runs>/study/<name>/summary.json)."""

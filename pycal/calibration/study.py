@@ -47,7 +47,7 @@ class Study:
         if isinstance(seed_base, bool) or not isinstance(seed_base, int) or seed_base < 0:
             raise PycalError(f"--seed-base {seed_base!r}: must be a whole number >= 0")
         self.seed_base = seed_base
-        self.seeds = list(range(seed_base, seed_base + int(self.cfg["seeds_count"])))
+        self.seeds = self.seeds_from_base(self.cfg["seeds_count"])
         self.overrides = {m: {} for m in self.cfg["materials"]}
         self.intervals = {m: {} for m in self.cfg["materials"]}   # key -> (estimate, low, high) found so far
         self.stage_rows, self.points, self.runs = [], [], []
@@ -195,6 +195,10 @@ class Study:
         tg = [t.__dict__ for t in self.targets[(material, st["label"])]]
         return self.journal.stage(f"{material}/{st['label']}",
                                   fingerprint(st, self.seeds, sorted(self.overrides[material].items()), tg))
+
+    def seeds_from_base(self, count):
+        """`count` seeds from the study's seed base: seed_base, seed_base + 1, ..."""
+        return list(range(self.seed_base, self.seed_base + int(count)))
 
     def _stage_cost(self, material, st, elapsed_s, simulated_count):
         """(runs simulated, wall time s) of a stage over every process that worked on it:

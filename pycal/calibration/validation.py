@@ -36,6 +36,7 @@ from ..post import mean_std
 from ..post import compression as post_compression
 from ..post import lab_curves
 from ..plotting import new_figure, save_png
+from .calibrated import run_overrides
 
 CURVE = "ucs"   # compare: {response: ucs, lab: {curve: NAME}}: the result's curves against that lab curve
 
@@ -84,12 +85,6 @@ def lab_value(spec):
     return None if v is None or (isinstance(v, float) and math.isnan(v)) else float(v)
 
 
-def overrides_for(study, pred):
-    """Job overrides carrying the calibrated values into the prediction's material (set)."""
-    from .calibrated import overrides_for_material
-    return dict(pred.get("rig_overrides", {}), **overrides_for_material(study.overrides, pred["material"]))
-
-
 def compare_results(results, cmp):
     """One comparison over the seeds' results: sim mean and SD, lab value, band, z, inside."""
     if cmp["response"] == CURVE:
@@ -118,11 +113,11 @@ def run(study):
     section = study.cfg.get("validation")
     if not section:
         return []
-    seeds = list(range(study.seed_base, study.seed_base + int(section.get("seeds_count", len(study.seeds)))))
+    seeds = study.seeds_from_base(section.get("seeds_count", len(study.seeds)))
     rows = []
     for pred in section["predictions"]:
         study.log(f"[validation] {pred['name']}: {pred['rig']} on {pred['material']} with the calibrated values")
-        extra = overrides_for(study, pred)
+        extra = run_overrides(study.overrides, pred)
         try:
             results = study._run_seeds(pred["rig"], pred["material"], extra, seeds)
         except RunError as exc:
@@ -150,7 +145,7 @@ def sensitivity(study, pred, extra, cfg, missed, cmp):
     """Change of the missed response when each calibrated parameter of the prediction's
     material(s) moves by +relative_step_fraction (one run set per parameter)."""
     step = cfg["relative_step_fraction"]
-    seeds = list(range(study.seed_base, study.seed_base + int(cfg.get("seeds_count", 3))))
+    seeds = study.seeds_from_base(cfg.get("seeds_count", 3))
     base = missed["sim_mean"]
     out = []
     for key, value in extra.items():
