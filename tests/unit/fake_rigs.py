@@ -24,6 +24,29 @@ def bulk_law(job):
     return 0.35 * mat["particles"]["density_kg_m3"] * (1 - 0.1 * eta)
 
 
+# The head of a study config that calibrates the dry fines' rolling resistance on the fake
+# AoR law (above), for the tests of what runs after the calibration (validation, application):
+# a test puts its name before it and its own section after it.
+ROLLING_STUDY_HEAD = """seeds_count: 3
+max_runs_count: 300
+materials:
+  M3-dry:
+    - stage: rolling_resistance
+      rig: aor
+      response: aor_mean_deg
+      target: {sample: fines_dry, test: angle_of_repose, band_deg: 1.0}
+      parameter:
+        keys: [interactions.M3-dry.rolling_resistance_coefficient,
+               interactions.steel.rolling_resistance_coefficient,
+               interactions.pvc.rolling_resistance_coefficient]
+        start: 0.35
+        bounds: [0.05, 1.5]
+        response_increases: true
+        tolerance_coefficient: 0.02
+      max_runs_count: 30
+"""
+
+
 class FakeRigs:
     """run(jobs, raise_on_error) -> results like runner.LocalPool, with .simulated_count and
     .last_errors. results: {rig: function(job) -> dict of measurements}; noise: {key: sd}

@@ -7,30 +7,13 @@ import json
 
 import pytest
 
-from fake_rigs import FakeRigs
+from fake_rigs import FakeRigs, ROLLING_STUDY_HEAD
 from pycal.calibration.study import Study
 from pycal.errors import ConfigError
 
 STUDY = """
 name: app
-seeds_count: 3
-max_runs_count: 300
-materials:
-  M3-dry:
-    - stage: rolling_resistance
-      rig: aor
-      response: aor_mean_deg
-      target: {sample: fines_dry, test: angle_of_repose, band_deg: 1.0}
-      parameter:
-        keys: [interactions.M3-dry.rolling_resistance_coefficient,
-               interactions.steel.rolling_resistance_coefficient,
-               interactions.pvc.rolling_resistance_coefficient]
-        start: 0.35
-        bounds: [0.05, 1.5]
-        response_increases: true
-        tolerance_coefficient: 0.02
-      max_runs_count: 30
-application:
+""" + ROLLING_STUDY_HEAD + """application:
   seeds_count: 3
   runs:
     - name: chute_dry

@@ -6,30 +6,13 @@ import json
 
 import pytest
 
-from fake_rigs import FakeRigs, aor_law
+from fake_rigs import FakeRigs, ROLLING_STUDY_HEAD, aor_law
 from pycal.calibration.study import Study
 from pycal.errors import ConfigError
 
 STUDY = """
 name: val
-seeds_count: 3
-max_runs_count: 300
-materials:
-  M3-dry:
-    - stage: rolling_resistance
-      rig: aor
-      response: aor_mean_deg
-      target: {sample: fines_dry, test: angle_of_repose, band_deg: 1.0}
-      parameter:
-        keys: [interactions.M3-dry.rolling_resistance_coefficient,
-               interactions.steel.rolling_resistance_coefficient,
-               interactions.pvc.rolling_resistance_coefficient]
-        start: 0.35
-        bounds: [0.05, 1.5]
-        response_increases: true
-        tolerance_coefficient: 0.02
-      max_runs_count: 30
-validation:
+""" + ROLLING_STUDY_HEAD + """validation:
   seeds_count: 4
   sensitivity: {relative_step_fraction: 0.2, seeds_count: 2}
   predictions:
