@@ -348,17 +348,32 @@ def _take_from_components(c, data, materials):
         to = str(rule["to"]).split(".")
         if len(to) < 4 or to[0] != "cross_interactions" or to[1] not in comps or to[2] not in comps:
             c.fail(f"{k}.to", f"{rule['to']!r} must be cross_interactions.<A>.<B>.<property> of two components")
-        node = materials[rule["from"]]
-        for part in str(rule["key"]).split("."):
-            if not isinstance(node, dict) or part not in node:
-                c.fail(f"{k}.key", f"{rule['key']!r}: no such key in configs/materials/{rule['from']}.yaml")
-            node = node[part]
-        pair = data["cross_interactions"].get(to[1], {}).get(to[2])
-        if not isinstance(pair, dict):
+        if component_value(materials, rule) is None:
+            c.fail(f"{k}.key", f"{rule['key']!r}: no such key in configs/materials/{rule['from']}.yaml")
+        if not isinstance(data["cross_interactions"].get(to[1], {}).get(to[2]), dict):
             c.fail(f"{k}.to", f"cross_interactions.{to[1]}.{to[2]} is not in the set (write the pair as A: {{B: ...}})")
-        for part in to[3:-1]:
-            pair = pair.setdefault(part, {})
-        pair[to[-1]] = copy.deepcopy(node)
+        put_component_value(data, rule, materials)
+
+
+def component_value(materials, rule):
+    """The value a from_components rule takes: `key` of material `from` in `materials`
+    ({name: config}), or None when there is no such key."""
+    node = materials.get(rule.get("from"))
+    for part in str(rule.get("key", "")).split("."):
+        if not isinstance(node, dict) or part not in node:
+            return None
+        node = node[part]
+    return node
+
+
+def put_component_value(data, rule, materials):
+    """Write a copy of the rule's component value at its `to` path (cross_interactions.A.B.
+    <key>) of the set `data`, creating the last levels below the pair. The value must exist."""
+    to = str(rule["to"]).split(".")
+    node = data["cross_interactions"][to[1]][to[2]]
+    for part in to[3:-1]:
+        node = node.setdefault(part, {})
+    node[to[-1]] = copy.deepcopy(component_value(materials, rule))
 
 
 def validate_material_set(data, path, materials):

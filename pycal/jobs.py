@@ -16,7 +16,8 @@ import yaml
 from . import CONFIG_DIR
 from .configs import (parse_yaml_text, load_boundaries_cached, load_material, load_rig, material_names,
                       validate_material, check_rig_keys, check_numerics_choices, _Checker)
-from .configs import SET_DIR, load_yaml, material_set_names, rig_names, validate_material_set
+from .configs import (SET_DIR, component_value, load_yaml, material_set_names, put_component_value, rig_names,
+                      validate_material_set)
 from .contact_rules import ContactRuleError, check_job
 from .errors import ConfigError
 from . import step_estimate
@@ -139,15 +140,10 @@ def _own_carried_key(raw, key, known):
     for rule in list(rules):
         to = str(rule.get("to", ""))
         if key == to or key.startswith(to + "."):
-            node = known.get(rule.get("from"), {})
-            for part in str(rule.get("key", "")).split("."):
-                node = node.get(part) if isinstance(node, dict) else None
             parts = to.split(".")
-            pair = raw.get("cross_interactions", {})
-            for part in parts[1:-1]:
-                pair = pair.setdefault(part, {}) if isinstance(pair, dict) else {}
-            if isinstance(pair, dict) and node is not None:
-                pair[parts[-1]] = copy.deepcopy(node)
+            pair = raw.get("cross_interactions", {}).get(parts[1], {}).get(parts[2]) if len(parts) >= 4 else None
+            if isinstance(pair, dict) and component_value(known, rule) is not None:
+                put_component_value(raw, rule, known)
             rules.remove(rule)
 
 
