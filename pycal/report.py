@@ -132,9 +132,14 @@ def _validation(study_dir, rows):
     for r in rows:
         if r.get("sensitivity"):
             parts.append(f"<p>{_esc(r['prediction'])}: what drives the miss (each calibrated value moved, change of "
-                         f"{_esc(next(c['response'] for c in r['comparisons'] if not c['inside']))}):</p><ul>")
+                         f"{_esc(next(c['response'] for c in r['comparisons'] if not c['inside']))}, paired by seed "
+                         f"with the prediction, +- its standard error):</p><ul>")
             for x in r["sensitivity"][:6]:
                 change = "runs failed" if x["change"] is None else f"{x['change']:+.3g}"
+                if x["change"] is not None and x.get("change_se") is not None:
+                    change += f" +- {x['change_se']:.2g}"
+                    if abs(x["change"]) < 2 * x["change_se"]:
+                        change += " (within 2 standard errors of 0: seed noise)"
                 parts.append(f"<li>{_esc(x['parameter'])} {_num(x['value'])} -> {_num(x['moved_to'])}: {change}</li>")
             parts.append("</ul>")
         if r.get("plot") and (study_dir / r["plot"]).is_file():

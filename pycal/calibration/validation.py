@@ -23,6 +23,10 @@ a curve comparison is inside when its RMS band z is <= 1 (pycal.post.compression
 prediction that misses (any comparison outside) gets a sensitivity run when it asks for
 one (`sensitivity: true`, settings in the section): each calibrated parameter of the material(s) moved by +relative_step, the
 change of the first missed response per parameter, largest first ("what drives it").
+The change is paired by seed: each moved run is compared with the prediction's run on the
+same seed (seeds 1..seeds_count of the prediction), which cancels the part of the seed
+noise that a seed carries whatever the parameter; its standard error is the SD of the
+per-seed changes / sqrt(n) (a curve comparison: difference of the means, no error).
 Outputs: <study>/validation.csv, validation.json, plots/validation-<name>.png.
 """
 import json
@@ -130,7 +134,8 @@ def run(study):
                "plot": plot(study, pred["name"], comps)}
         missed = [c for c, cmp in zip(comps, pred["compare"]) if not c["inside"]]
         if missed and pred.get("sensitivity"):
-            row["sensitivity"] = sensitivity(study, pred, extra, section["sensitivity"], missed[0],
+            base_by_seed = dict(zip(row["seeds"], results))
+            row["sensitivity"] = sensitivity(study, pred, extra, section["sensitivity"], base_by_seed,
                                              pred["compare"][comps.index(missed[0])])
         for c in comps:
             study.log(f"  {c['response']}: {c['sim_mean']:.4g} +/- {c['sim_sd']:.2g} (n={c['n']}) vs lab "
@@ -141,29 +146,53 @@ def run(study):
     return rows
 
 
-def sensitivity(study, pred, extra, cfg, missed, cmp):
-    """Change of the missed response when each calibrated parameter of the prediction's
-    material(s) moves by +relative_step_fraction (one run set per parameter)."""
+def sensitivity(study, pred, extra, cfg, base_by_seed, cmp):
+    """Change of the first missed response when each calibrated parameter of the
+    prediction's material(s) moves by +relative_step_fraction (one run set per parameter),
+    paired by seed with the prediction's runs (base_by_seed: {seed: result})."""
     step = cfg["relative_step_fraction"]
     seeds = study.seeds_from_base(cfg.get("seeds_count", 3))
-    base = missed["sim_mean"]
     out = []
     for key, value in extra.items():
         if key.startswith("rig.") or not isinstance(value, (int, float)) or isinstance(value, bool) or value == 0:
             continue
         moved = dict(extra, **{key: value * (1 + step)})
+        row = {"parameter": key, "value": value, "moved_to": value * (1 + step), "change": None,
+               "change_se": None, "seeds": [], "error": None}
         try:
             res = study._run_seeds(pred["rig"], pred["material"], moved, seeds)
         except RunError as exc:
-            out.append({"parameter": key, "value": value, "moved_to": value * (1 + step), "change": None,
-                        "error": str(exc)})
+            out.append(dict(row, error=str(exc)))
             continue
-        c = compare_results(res, cmp)
-        out.append({"parameter": key, "value": value, "moved_to": value * (1 + step),
-                    "change": c["sim_mean"] - base, "error": None})
-        study.log(f"  sensitivity {key} x{1 + step:g}: {missed['response']} {c['sim_mean'] - base:+.3g}")
-    out.sort(key=lambda r: -abs(r["change"]) if r["change"] is not None else 0)
+        row.update(paired_change(dict(zip(study.last_seeds, res)), base_by_seed, cmp))
+        out.append(row)
+        se = f" +- {row['change_se']:.2g}" if row["change_se"] is not None else ""
+        study.log(f"  sensitivity {key} x{1 + step:g}: {cmp['response']} {row['change']:+.3g}{se} "
+                  f"(paired on seeds {row['seeds']})")
+    out.sort(key=lambda r: -abs(r["change"]) if r["change"] is not None and not math.isnan(r["change"]) else 0)
     return out
+
+
+def paired_change(moved_by_seed, base_by_seed, cmp):
+    """Mean change of a response from the base runs to the moved runs over the seeds both
+    have: {change, change_se (None below 2 pairs or for a curve), seeds}."""
+    seeds = sorted(set(moved_by_seed) & set(base_by_seed))
+    if not seeds:
+        raise RunError("sensitivity: no seed in common with the prediction's runs")
+    if cmp["response"] == CURVE:
+        change = (compare_results([moved_by_seed[s] for s in seeds], cmp)["sim_mean"]
+                  - compare_results([base_by_seed[s] for s in seeds], cmp)["sim_mean"])
+        return {"change": change, "change_se": None, "seeds": seeds}
+    diffs, used = [], []
+    for s in seeds:
+        a, b = moved_by_seed[s].get(cmp["response"]), base_by_seed[s].get(cmp["response"])
+        if all(isinstance(v, (int, float)) and not math.isnan(v) for v in (a, b)):
+            diffs.append(a - b)
+            used.append(s)
+    if not diffs:
+        return {"change": math.nan, "change_se": None, "seeds": []}
+    mean, sd = mean_std(diffs)
+    return {"change": mean, "change_se": sd / math.sqrt(len(diffs)) if len(diffs) > 1 else None, "seeds": used}
 
 
 def plot(study, name, comps):

@@ -117,3 +117,22 @@ def test_a_set_override_wins_over_the_component_value_it_would_take():
                                                  "M3-wet.interactions.steel.cohesion.force_fraction": 0.2})
     assert job["materials"]["M2"]["interactions"]["M3-wet"]["cohesion"]["force_fraction"] == 1.0
     assert job["materials"]["M1"]["interactions"]["M3-wet"]["cohesion"]["force_fraction"] == 0.2
+
+
+def test_the_sensitivity_change_is_paired_by_seed(tmp_path):
+    """A seed that piles 10 deg higher whatever the parameter (as a DEM packing can) must not
+    show up as a change: the moved runs are compared with the prediction's runs on the same
+    seeds. The unpaired difference (2-seed moved mean vs 4-seed prediction mean) would be off by
+    the seed offsets' mean over seeds 1-2 minus over 1-4: -10 deg."""
+    def offset_surcharge(job):
+        return {"surcharge_mean_deg": 0.6 * aor_law(job) + 10.0 * (job["seed"] - 2.5)}
+    p = tmp_path / "val.yaml"
+    p.write_text(STUDY)
+    ex = FakeRigs(results={"surcharge": offset_surcharge}, noise={"surcharge_mean_deg": 0.1})
+    s = Study(p, ex, tmp_path / "out", log=lambda m: None)
+    s.run()
+    rolling = s.overrides["M3-dry"]["interactions.M3-dry.rolling_resistance_coefficient"]
+    top = s.validation_rows[1]["sensitivity"][0]
+    assert top["change"] == pytest.approx(0.6 * 40 * 0.2 * rolling, abs=0.5)
+    assert top["seeds"] == [1, 2]
+    assert 0 < top["change_se"] < 0.5
