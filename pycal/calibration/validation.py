@@ -138,9 +138,10 @@ def run(study):
             row["sensitivity"] = sensitivity(study, pred, extra, section["sensitivity"], base_by_seed,
                                              pred["compare"][comps.index(missed[0])])
         for c in comps:
-            study.log(f"  {c['response']}: {c['sim_mean']:.4g} +/- {c['sim_sd']:.2g} (n={c['n']}) vs lab "
-                      f"{c['lab'] if c['lab'] is not None else '-'} +/- {c['band']}: "
-                      f"{'inside' if c['inside'] else 'MISSED'}")
+            sim = (f"{c['sim_mean']:.4g} +/- {c['sim_sd']:.2g} (n={c['n']})" if c["n"]
+                   else "no value on any seed")
+            study.log(f"  {c['response']}: {sim} vs lab {c['lab'] if c['lab'] is not None else '-'} +/- "
+                      f"{c['band']}: {'inside' if c['inside'] else 'MISSED'}")
         rows.append(row)
         write(study, rows)
     return rows
@@ -198,13 +199,19 @@ def paired_change(moved_by_seed, base_by_seed, cmp):
 def plot(study, name, comps):
     """Simulated mean +- SD against the lab value and its band, one bar per comparison."""
     fig, ax = new_figure(figsize=(max(4.5, 1.3 * len(comps) + 2), 3.6))
+    labelled = False
     for i, c in enumerate(comps):
         if c["lab"] is not None:
             ax.fill_between([i - 0.35, i + 0.35], c["lab"] - c["band"], c["lab"] + c["band"], color="0.85",
                             label="lab band" if i == 0 else None)
             ax.plot([i - 0.35, i + 0.35], [c["lab"]] * 2, color="k", lw=1, label="lab" if i == 0 else None)
+        if c["n"] == 0:                  # no seed gave a value (e.g. a pile too flat for an angle)
+            ax.annotate("no value\non any seed", (i, c["lab"] if c["lab"] is not None else 0.0), ha="center",
+                        va="bottom", fontsize=7, color="C3")
+            continue
         ax.errorbar([i], [c["sim_mean"]], yerr=[c["sim_sd"]], fmt="o", color="C0", capsize=4,
-                    label="predicted (seed mean +- SD)" if i == 0 else None)
+                    label=None if labelled else "predicted (seed mean +- SD)")
+        labelled = True
     ax.set_xticks(range(len(comps)))
     ax.set_xticklabels([c["response"] for c in comps], rotation=20, ha="right", fontsize=8)
     ax.set_title(f"validation: {name}", fontsize=9)

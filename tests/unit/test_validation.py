@@ -136,3 +136,17 @@ def test_the_sensitivity_change_is_paired_by_seed(tmp_path):
     assert top["change"] == pytest.approx(0.6 * 40 * 0.2 * rolling, abs=0.5)
     assert top["seeds"] == [1, 2]
     assert 0 < top["change_se"] < 0.5
+
+
+def test_a_prediction_with_no_value_on_any_seed_is_reported_not_a_crash(tmp_path):
+    """A surcharge pile too flat for an angle on every seed (the calibrated fines did this):
+    the comparison has n = 0 and misses, the study goes on to write its outputs and plot."""
+    p = tmp_path / "val.yaml"
+    p.write_text(STUDY)
+    ex = FakeRigs(results={"surcharge": lambda job: {"surcharge_mean_deg": None}})
+    s = Study(p, ex, tmp_path / "out", log=lambda m: None)
+    s.run()
+    c = s.validation_rows[1]["comparisons"][0]
+    assert c["n"] == 0 and not c["inside"]
+    assert (s.out / "plots" / "validation-fines_dry_surcharge.png").is_file()
+    assert (s.out / "summary.json").is_file()
