@@ -327,6 +327,7 @@ def procedure(scene, out_dir):
         "feed_time_s": rig.feed_time,
         "layers_count": feeder.n_layers,
         "n_particles_fed": feeder.count,
+        "n_particles_left_out": feeder.left_count,
         "n_particles_end": len(feeder.bodies),
         "n_particle_spheres_end": len(sc.live_spheres()),
         "max_overlap_ratio": rig.max_overlap_ratio,

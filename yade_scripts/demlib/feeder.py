@@ -19,6 +19,10 @@ next one is made.
   y in [0, W) (the periodic slice). Random sequential placement of the particles' bounding
   spheres, largest first, none overlapping another or a particle already in the scene near
   the window (distance in y taken across the periodic boundary); lumps randomly oriented.
+- A particle that finds no place in placement_max_attempts_count tries is left out of its
+  layer; its mass stays in the deficit, so the next layers make it up (the fed mass is what
+  was made, and the stream's mass fractions keep to the rule above). Only when the deficit
+  left over exceeds one layer's mass is the window blocked and the run refused.
 """
 import math
 import random
@@ -50,8 +54,9 @@ def place_layer(particles, window, existing, rng, max_attempts):
 
     window: dict x_m (window centre), z_m (window height), length_m (Lf), width_m (W),
     height_m (h), slope (v0 / vz_i). existing: (k x 4 array of x, y, z, bounding radius) of
-    particles already in the scene near the window. Returns [(particle, (x, y, z), rotation
-    3x3 or None)], or None when a particle found no place in max_attempts tries."""
+    particles already in the scene near the window. Returns (placed, left): placed =
+    [(particle, (x, y, z), rotation 3x3 or None)], left = the particles that found no place in
+    max_attempts tries."""
     W = window["width_m"]
     order = sorted(particles, key=lambda p: -p["bound_radius_m"])
     pos = np.zeros((len(order) + len(existing), 3))
@@ -60,7 +65,7 @@ def place_layer(particles, window, existing, rng, max_attempts):
     if n:
         pos[:n] = np.asarray(existing, dtype=float)[:, :3]
         rad[:n] = np.asarray(existing, dtype=float)[:, 3]
-    out = []
+    out, left = [], []
     for p in order:
         b = p["bound_radius_m"]
         for _ in range(max_attempts):
@@ -74,12 +79,13 @@ def place_layer(particles, window, existing, rng, max_attempts):
                     continue
             break
         else:
-            return None
+            left.append(p)
+            continue
         pos[n], rad[n] = c, b
         n += 1
         rot = clumps.random_rotation(rng)[0] if p["kind"] == "clump" else None
         out.append((p, tuple(float(v) for v in c), rot))
-    return out
+    return out, left
 
 
 class Feeder:
@@ -100,6 +106,7 @@ class Feeder:
         self.bound_radius = {}
         self.layers_done = 0
         self.count = 0
+        self.left_count = 0           # particles left out of their layer (no room in the window)
         vz_i = geo["vertical_speed_at_injection_m_s"]
         wx, wz = geo["injection_window_centre_m"]
         self.window = {"x_m": wx, "z_m": wz, "length_m": geo["stream_length_m"], "width_m": geo["slice_width_m"],
@@ -132,11 +139,14 @@ class Feeder:
         k = self.layers_done
         deficits = {name: w * flow * (k + 1) * self.dt - self.fed_kg[name] for name, w in self.fractions.items()}
         parts = plan_layer(self.scene.job, deficits, self.rng)
-        placed = place_layer(parts, self.window, self._nearby(), self.rng, self.max_attempts)
-        if placed is None:
-            raise RigFailure(f"stream injection: layer {k} could not be placed in {self.max_attempts} tries per "
-                             f"particle (stream bulk density {self.geo['stream_bulk_density_at_injection_kg_m3']:.0f} "
-                             "kg/m3 at the injection window): inject lower or thin the layers")
+        placed, left = place_layer(parts, self.window, self._nearby(), self.rng, self.max_attempts)
+        self.left_count += len(left)
+        left_kg = sum(p["mass_kg"] for p in left)
+        if left_kg > flow * self.dt:
+            raise RigFailure(f"stream injection: layer {k}: {len(left)} particles ({left_kg:.3g} kg, more than one "
+                             f"layer's {flow * self.dt:.3g} kg) found no place in {self.max_attempts} tries each "
+                             f"(stream bulk density {self.geo['stream_bulk_density_at_injection_kg_m3']:.0f} kg/m3 "
+                             "at the injection window): inject lower or thin the layers")
         v0, vz_i, g = self.velocity[0], -self.velocity[2], self.geo["gravity_m_s2"]
         made = []
         for pl in placed:
