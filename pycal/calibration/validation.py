@@ -26,7 +26,7 @@ change of the first missed response per parameter, largest first ("what drives i
 The change is paired by seed: each moved run is compared with the prediction's run on the
 same seed (seeds 1..seeds_count of the prediction), which cancels the part of the seed
 noise that a seed carries whatever the parameter; its standard error is the SD of the
-per-seed changes / sqrt(n) (a curve comparison: difference of the means, no error).
+per-seed changes / sqrt(n) (a curve comparison: each seed's mean RMS band z).
 Outputs: <study>/validation.csv, validation.json, plots/validation-<name>.png.
 """
 import json
@@ -176,17 +176,17 @@ def sensitivity(study, pred, extra, cfg, base_by_seed, cmp):
 
 def paired_change(moved_by_seed, base_by_seed, cmp):
     """Mean change of a response from the base runs to the moved runs over the seeds both
-    have: {change, change_se (None below 2 pairs or for a curve), seeds}."""
+    have: {change, change_se (None below 2 pairs), seeds}. A curve comparison pairs each
+    seed's mean RMS band z."""
     seeds = sorted(set(moved_by_seed) & set(base_by_seed))
     if not seeds:
         raise RunError("sensitivity: no seed in common with the prediction's runs")
-    if cmp["response"] == CURVE:
-        change = (compare_results([moved_by_seed[s] for s in seeds], cmp)["sim_mean"]
-                  - compare_results([base_by_seed[s] for s in seeds], cmp)["sim_mean"])
-        return {"change": change, "change_se": None, "seeds": seeds}
     diffs, used = [], []
     for s in seeds:
-        a, b = moved_by_seed[s].get(cmp["response"]), base_by_seed[s].get(cmp["response"])
+        if cmp["response"] == CURVE:     # the seed's mean RMS band z over its curves
+            a, b = (compare_results([r[s]], cmp)["sim_mean"] for r in (moved_by_seed, base_by_seed))
+        else:
+            a, b = moved_by_seed[s].get(cmp["response"]), base_by_seed[s].get(cmp["response"])
         if all(isinstance(v, (int, float)) and not math.isnan(v) for v in (a, b)):
             diffs.append(a - b)
             used.append(s)

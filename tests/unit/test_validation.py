@@ -150,3 +150,16 @@ def test_a_prediction_with_no_value_on_any_seed_is_reported_not_a_crash(tmp_path
     assert c["n"] == 0 and not c["inside"]
     assert (s.out / "plots" / "validation-fines_dry_surcharge.png").is_file()
     assert (s.out / "summary.json").is_file()
+
+
+def test_a_curve_comparison_is_paired_seed_by_seed(monkeypatch):
+    """Curve responses (RMS band z per seed) pair like scalars: per-seed differences, their
+    mean and standard error (seed offsets cancel)."""
+    from pycal.calibration import validation
+    monkeypatch.setattr(validation, "compare_results", lambda results, cmp: {"sim_mean": results[0]["z"]})
+    base = {1: {"z": 1.0}, 2: {"z": 5.0}, 3: {"z": 3.0}}
+    moved = {1: {"z": 1.5}, 2: {"z": 5.7}, 3: {"z": 3.3}, 4: {"z": 9.0}}
+    r = validation.paired_change(moved, base, {"response": validation.CURVE})
+    assert r["seeds"] == [1, 2, 3]
+    assert r["change"] == pytest.approx(0.5)
+    assert r["change_se"] == pytest.approx(0.2 / 3 ** 0.5)
