@@ -155,6 +155,52 @@ def plan(jobs, workers=1, replicas=None, layout=DEFAULT_LAYOUT):
     return out
 
 
+def candidate_batches(seed, asked, largest):
+    """Seed lists of the batches `seed` may have run in: runs of consecutive seeds and
+    contiguous parts of `asked` (the seeds asked for its point, in order), 2 to `largest`
+    long, that hold it."""
+    out = []
+    for n in range(2, largest + 1):
+        out += [list(range(start, start + n)) for start in range(seed - n + 1, seed + 1)]
+        out += [asked[k:k + n] for k in range(len(asked) - n + 1) if seed in asked[k:k + n]]
+    unique = []
+    for c in out:
+        if c not in unique:
+            unique.append(c)
+    return unique
+
+
+def cached_seed_results(jobs, runs_dir):
+    """({index into jobs: per-seed result}, {index: failure message}) for the single-seed
+    jobs of rigs with replicas whose seed already ran alone or in a sequential batch
+    (candidate_batches) in runs_dir. A sequential replica's numbers equal its lone run's bit
+    for bit, so either stands for the seed, whatever batches the current worker count would
+    make; a seed its batch refused is refused again (kept, as a lone job's failure is)."""
+    from .executors.jobdirs import cached_result
+    asked = {}
+    for job in jobs:
+        if job["rig"] in REPLICA_RIGS and not is_batch(job):
+            asked.setdefault(_point_key(job), []).append(job["seed"])
+    out, refused = {}, {}
+    for i, job in enumerate(jobs):
+        if job["rig"] not in REPLICA_RIGS or is_batch(job):
+            continue
+        lone = cached_result(job, runs_dir)
+        if lone is not None:
+            out[i] = lone
+            continue
+        for seeds in candidate_batches(job["seed"], asked[_point_key(job)], REPLICA_RIGS[job["rig"]]):
+            res = cached_result(batch_job(job, seeds, "sequential"), runs_dir)
+            row = res and next((x for x in expand(res) if x[0] == job["seed"]), None)
+            if row:
+                if row[1] is not None:
+                    out[i] = row[1]
+                else:
+                    refused[i] = row[2]
+                break
+    return out, refused
+
+
 class ReplicaExecutor:
     """An executor (pycal.runner interface: run(jobs, raise_on_error) -> results in the
     order of jobs) that runs single-seed jobs of rigs with replicas as batch jobs on an
@@ -195,6 +241,27 @@ class ReplicaExecutor:
         return plan(jobs, getattr(self.inner, "workers", 1), self.replicas, self.layout)
 
     def run(self, jobs, raise_on_error=True):
+        """Results of single-seed `jobs` (executor interface). In the sequential layout a seed
+        that already ran, alone or in any batch, is taken from there (cached_seed_results):
+        the batches of another worker count are not simulated again."""
+        found, refused = {}, {}
+        if self.layout == "sequential" and self.replicas is None and hasattr(self.inner, "runs_dir"):
+            found, refused = cached_seed_results(jobs, self.inner.runs_dir)
+        if not found and not refused:
+            return self._run(jobs, raise_on_error)
+        rest = [i for i in range(len(jobs)) if i not in found and i not in refused]
+        results = [found.get(i) for i in range(len(jobs))]
+        errors = list(refused.values())
+        self.last_errors = []
+        if rest:
+            for i, r in zip(rest, self._run([jobs[i] for i in rest], raise_on_error=False)):
+                results[i] = r
+        self.last_errors = errors + self.last_errors
+        if self.last_errors and raise_on_error:
+            raise RunError(f"{len(self.last_errors)} of {len(jobs)} seed run(s) failed; first: {self.last_errors[0]}")
+        return results
+
+    def _run(self, jobs, raise_on_error=True):
         from .runner import cached_failure, cached_result
         # an executor without a runs folder (a stand-in) cannot read batch results: no batches
         plan = self.plan(jobs) if hasattr(self.inner, "runs_dir") else [(j, [i]) for i, j in enumerate(jobs)]

@@ -208,3 +208,35 @@ def test_cli_reports_a_failed_seed_exit_3(tmp_path, fake_yade, monkeypatch, caps
     rc = main(["run", "fill", "--material", "M2", "--seeds", "3", "--workers", "1", "--out", str(tmp_path / "r")])
     err = capsys.readouterr().err
     assert rc == 3 and "no rest after 8 s" in err and "-s2" in err
+
+
+def test_another_worker_count_reuses_the_seeds_already_run(tmp_path, fake_yade):
+    """A study resumed with another --workers makes other batches; a seed that ran alone
+    or in a sequential batch is taken from there, not simulated again (its numbers are the
+    same bit for bit)."""
+    jobs = jobs_of([1, 2, 3])
+    lone = replicas.ReplicaExecutor(runner.LocalPool(tmp_path / "runs", workers=3, progress=False))
+    first = lone.run(jobs)                                   # 3 workers: 3 lone jobs
+    assert len(fake_yade()) == 3
+    two = replicas.ReplicaExecutor(runner.LocalPool(tmp_path / "runs", workers=2, progress=False))
+    assert two.run(jobs) == first and len(fake_yade()) == 3 and two.simulated_count == 0
+    # the other way: one batch of 3 (1 worker), then lone jobs (3 workers) and a new seed
+    jobs = jobs_of([11, 12, 13])
+    one = replicas.ReplicaExecutor(runner.LocalPool(tmp_path / "runs", workers=1, progress=False))
+    batch = one.run(jobs)
+    assert len(fake_yade()) == 4 and fake_yade()[-1].startswith("fill-M2-s11x3-")
+    three = replicas.ReplicaExecutor(runner.LocalPool(tmp_path / "runs", workers=3, progress=False))
+    again = three.run(jobs_of([11, 12, 13, 14]))
+    assert again[:3] == batch and again[3]["bulk_density_kg_m3"] == 1014.0
+    assert len(fake_yade()) == 5 and three.simulated_count == 1
+
+
+def test_side_by_side_batches_are_not_reused_for_other_batches(tmp_path, fake_yade):
+    """Side by side, a replica's numbers depend on its batch-mates: no reuse."""
+    jobs = jobs_of([1, 2])
+    replicas.ReplicaExecutor(runner.LocalPool(tmp_path / "runs", workers=1, progress=False),
+                             layout="side_by_side").run(jobs)
+    two = replicas.ReplicaExecutor(runner.LocalPool(tmp_path / "runs", workers=2, progress=False),
+                                   layout="side_by_side")
+    two.run(jobs)
+    assert len(fake_yade()) == 3
