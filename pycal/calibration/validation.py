@@ -180,7 +180,8 @@ def paired_change(moved_by_seed, base_by_seed, cmp):
     seed's mean RMS band z."""
     seeds = sorted(set(moved_by_seed) & set(base_by_seed))
     if not seeds:
-        raise RunError("sensitivity: no seed in common with the prediction's runs")
+        return {"change": math.nan, "change_se": None, "seeds": [],
+                "error": "no seed in common with the prediction's runs (each was replaced)"}
     diffs, used = [], []
     for s in seeds:
         if cmp["response"] == CURVE:     # the seed's mean RMS band z over its curves
