@@ -53,6 +53,24 @@ def _set_path(tree, dotted, value, where):
             node = node[part]
 
 
+def override_value(job, key):
+    """The value that override `key` addresses in resolved `job`: a key of the job's
+    material, or '<component>.<key>' of a material set's component (as resolve_job reads
+    them). None for a rig or set key, or a path the job does not have."""
+    if key.startswith("rig."):
+        return None
+    head, _, rest = key.partition(".")
+    if job.get("material_set") is not None:
+        node, parts = job["materials"].get(head), rest.split(".") if rest else []
+    else:
+        node, parts = job["materials"][job["material"]], key.split(".")
+    for part in parts:
+        if not isinstance(node, dict) or part not in node:
+            return None
+        node = node[part]
+    return node if parts else None
+
+
 def resolve_job(rig, material, overrides=None, seed=1, config_dir=CONFIG_DIR):
     """Build the explicit job dict.
 

@@ -21,8 +21,10 @@ compares responses with the lab, with the seed spread:
 A scalar comparison is inside when |sim mean - lab| <= band (its z = (sim - lab) / band);
 a curve comparison is inside when its RMS band z is <= 1 (pycal.post.compression). A
 prediction that misses (any comparison outside) gets a sensitivity run when it asks for
-one (`sensitivity: true`, settings in the section): each calibrated parameter of the material(s) moved by +relative_step, the
-change of the first missed response per parameter, largest first ("what drives it").
+one (`sensitivity: true`, settings in the section): each calibrated parameter of the
+material(s), and each key of its `sensitivity_extra` list (start values no stage fits, e.g.
+M3-wet.interactions.M3-wet.cohesion.force_fraction), moved by +relative_step, the change
+of the first missed response per parameter, largest first ("what drives it").
 The change is paired by seed: each moved run is compared with the prediction's run on the
 same seed (seeds 1..seeds_count of the prediction), which cancels the part of the seed
 noise that a seed carries whatever the parameter; its standard error is the SD of the
@@ -40,6 +42,7 @@ from ..post import mean_std
 from ..post import compression as post_compression
 from ..post import lab_curves
 from ..plotting import new_figure, save_png
+from ..jobs import override_value, resolve_job
 from .calibrated import run_overrides
 
 CURVE = "ucs"   # compare: {response: ucs, lab: {curve: NAME}}: the result's curves against that lab curve
@@ -60,9 +63,11 @@ def check(section, c, key="validation"):
     names = set()
     for i, p in enumerate(preds):
         k = f"{key}.predictions[{i}]"
-        c.keys(p, k, ["name", "rig", "material", "compare"], ["rig_overrides", "sensitivity"])
+        c.keys(p, k, ["name", "rig", "material", "compare"], ["rig_overrides", "sensitivity", "sensitivity_extra"])
         if p.get("sensitivity") and "sensitivity" not in section:
             c.fail(f"{k}.sensitivity", "needs the section's sensitivity settings (validation.sensitivity)")
+        if "sensitivity_extra" in p:
+            check_extra(p, c, k)
         if p["name"] in names:
             c.fail(f"{k}.name", f"{p['name']!r} is used twice")
         names.add(p["name"])
@@ -77,6 +82,22 @@ def check(section, c, key="validation"):
                 c.keys(lab, f"{ck}.lab", ["table", "sample", "column"])
                 if len(bands) != 1:
                     c.fail(ck, "a scalar comparison needs one band_<unit> (the lab value's band)")
+
+
+def check_extra(p, c, k):
+    """`sensitivity_extra`: keys of values no stage fits (start values) that the sensitivity
+    moves too; each must address a non-zero number of the prediction's material (set)."""
+    if not p.get("sensitivity"):
+        c.fail(f"{k}.sensitivity_extra", "needs sensitivity: true")
+    keys = p["sensitivity_extra"]
+    if not isinstance(keys, list) or not all(isinstance(x, str) for x in keys):
+        c.fail(f"{k}.sensitivity_extra", "must be a list of override keys (e.g. "
+                                          "M3-wet.interactions.M3-wet.cohesion.force_fraction)")
+    job = resolve_job(p["rig"], p["material"], p.get("rig_overrides", {}))
+    for x in keys:
+        v = override_value(job, x)
+        if isinstance(v, bool) or not isinstance(v, (int, float)) or v == 0:
+            c.fail(f"{k}.sensitivity_extra", f"{x}: not a non-zero number of {p['material']} (value {v!r})")
 
 
 def lab_value(spec):
@@ -153,10 +174,13 @@ def sensitivity(study, pred, extra, cfg, base_by_seed, cmp):
     paired by seed with the prediction's runs (base_by_seed: {seed: result})."""
     step = cfg["relative_step_fraction"]
     seeds = study.seeds_from_base(cfg.get("seeds_count", 3))
+    values = [(k, v) for k, v in extra.items()
+              if not k.startswith("rig.") and isinstance(v, (int, float)) and not isinstance(v, bool) and v != 0]
+    if pred.get("sensitivity_extra"):            # start values no stage fits, read from the job
+        job = resolve_job(pred["rig"], pred["material"], extra)
+        values += [(k, override_value(job, k)) for k in pred["sensitivity_extra"]]
     out = []
-    for key, value in extra.items():
-        if key.startswith("rig.") or not isinstance(value, (int, float)) or isinstance(value, bool) or value == 0:
-            continue
+    for key, value in values:
         moved = dict(extra, **{key: value * (1 + step)})
         row = {"parameter": key, "value": value, "moved_to": value * (1 + step), "change": None,
                "change_se": None, "seeds": [], "error": None}

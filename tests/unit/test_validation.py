@@ -25,6 +25,7 @@ name: val
       rig: surcharge
       material: M3-dry
       sensitivity: true
+      sensitivity_extra: [interactions.M3-dry.friction_coefficient]
       compare:
         - {response: surcharge_mean_deg, lab: {table: surcharge, sample: fines_dry, column: left_deg}, band_deg: 2.0}
 """
@@ -163,3 +164,26 @@ def test_a_curve_comparison_is_paired_seed_by_seed(monkeypatch):
     assert r["seeds"] == [1, 2, 3]
     assert r["change"] == pytest.approx(0.5)
     assert r["change_se"] == pytest.approx(0.2 / 3 ** 0.5)
+
+
+def test_sensitivity_extra_moves_a_start_value_read_from_the_job(study):
+    """A start value no stage fits (here the fines' particle friction, which the fake
+    surcharge does not depend on) is moved from its config value: change ~0."""
+    from pycal.jobs import resolve_job
+    s, _ = study
+    rows = {r["parameter"]: r for r in s.validation_rows[1]["sensitivity"]}
+    f = rows["interactions.M3-dry.friction_coefficient"]
+    assert f["value"] == resolve_job("surcharge", "M3-dry")["materials"]["M3-dry"]["interactions"]["M3-dry"][
+        "friction_coefficient"]
+    assert f["moved_to"] == pytest.approx(1.2 * f["value"])
+    assert abs(f["change"]) < 1.5
+    assert "interactions.M3-dry.rolling_resistance_coefficient" in rows     # and the calibrated ones
+
+
+def test_a_sensitivity_extra_key_the_material_lacks_is_a_config_error(tmp_path):
+    p = tmp_path / "bad.yaml"
+    p.write_text(STUDY.replace("[interactions.M3-dry.friction_coefficient]", "[interactions.M3-dry.stickiness]"))
+    from pycal.calibration.study_config import load_study
+    with pytest.raises(ConfigError, match=r"sensitivity_extra: interactions.M3-dry.stickiness: not a non-zero "
+                                          r"number of M3-dry"):
+        load_study(p)
