@@ -83,7 +83,9 @@ def resolve_job(rig, material, overrides=None, seed=1, config_dir=CONFIG_DIR):
         return resolve_set_job(rig, material, overrides, seed, config_dir)
     rig_cfg = load_rig(rig, config_dir)
     mat = copy.deepcopy(load_material(material, config_dir))
-    overrides = dict(overrides or {})
+    # a copy: a subtree override (a dict) is put into the material as it is, and a leaf
+    # override below it then writes into it; the caller's dict must not change with it
+    overrides = copy.deepcopy(dict(overrides or {}))
     for key, value in overrides.items():
         if key.startswith("rig."):
             _set_path(rig_cfg, key[4:], value, f"overrides of configs/rigs/{rig}.yaml")
@@ -119,7 +121,9 @@ def resolve_set_job(rig, set_name, overrides=None, seed=1, config_dir=CONFIG_DIR
     raw = load_yaml(Path(config_dir) / SET_DIR / f"{set_name}.yaml")
     known = {m: copy.deepcopy(load_material(m, config_dir)) for m in material_names(config_dir)}
     comps = list(raw.get("components") or {}) if isinstance(raw.get("components"), dict) else []
-    overrides = dict(overrides or {})
+    # a copy: a subtree override (a dict) is put into the material as it is, and a leaf
+    # override below it then writes into it; the caller's dict must not change with it
+    overrides = copy.deepcopy(dict(overrides or {}))
     set_keys = []
     for key, value in overrides.items():
         head = key.split(".", 1)[0]

@@ -187,3 +187,22 @@ def test_a_sensitivity_extra_key_the_material_lacks_is_a_config_error(tmp_path):
     with pytest.raises(ConfigError, match=r"sensitivity_extra: interactions.M3-dry.stickiness: not a non-zero "
                                           r"number of M3-dry"):
         load_study(p)
+
+
+def test_a_leaf_override_does_not_write_into_the_callers_subtree():
+    """A stage sets a whole cohesion subtree and a later run moves one leaf below it: the
+    job has the moved leaf, the caller's overrides (the study's calibrated values) keep
+    theirs, so the next job without that leaf gets the subtree's own value. (The study's
+    sensitivity on the wet pile's force_fraction made every later wet run use 0.6.)"""
+    from pycal.jobs import resolve_job
+    sub = {"model": "hysteretic", "force_fraction": 0.5, "pressure_fraction": 0.05, "update_interval_s": 0.01}
+    calibrated = {"interactions.M3-wet.cohesion": sub}
+    moved = dict(calibrated, **{"interactions.M3-wet.cohesion.force_fraction": 0.6})
+    for material, prefix in (("M3-wet", ""), ("mixed-wet", "M3-wet.")):
+        rig = "aor_mixed" if material == "mixed-wet" else "aor"
+        over = {prefix + k: v for k, v in moved.items()}
+        job = resolve_job(rig, material, over)
+        assert job["materials"]["M3-wet"]["interactions"]["M3-wet"]["cohesion"]["force_fraction"] == 0.6
+        assert sub["force_fraction"] == 0.5
+        job = resolve_job(rig, material, {prefix + k: v for k, v in calibrated.items()})
+        assert job["materials"]["M3-wet"]["interactions"]["M3-wet"]["cohesion"]["force_fraction"] == 0.5
