@@ -9,9 +9,9 @@ A bench-only dependency (PyPI), never installed by ./run.sh:
 
 The twin folder is one bench/twin.py wrote (its targets and hidden values, twin.json /
 results line): GrainLearning's iterative Bayesian filter gets the same targets (cell-fill
-bulk density and angle of repose, each weighed by its relative standard error squared, as the
-project's engine weighs by the target's standard error) and calls this project's job runner for every sample (fill + aor at the sample's particle
-density and rolling resistance, `--seeds-count` seeds each, lift 10 mm/s as the study), with
+bulk density and angle of repose, each weighed by its relative standard error squared, as
+the project's engine weighs by the target's standard error) and calls this project's job
+runner for every sample (fill + aor at the sample's particle density and rolling resistance, `--seeds-count` seeds each, lift 10 mm/s as the study), with
 the runs cached in <twin-dir>/grainlearning/runs. Hidden parameters it calibrates: particle
 density and rolling resistance (the twin must hide those two). Reports per parameter the
 estimate (posterior mean of the last iteration), its +-2 sigma range, the error against the

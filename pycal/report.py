@@ -131,11 +131,13 @@ def _validation(study_dir, rows):
     parts.append("</table>")
     for r in rows:
         if r.get("sensitivity"):
-            parts.append(f"<p>{_esc(r['prediction'])}: what drives the miss (each calibrated value moved, change of "
+            parts.append(f"<p>{_esc(r['prediction'])}: what drives the miss (each calibrated value, and each start "
+                         f"value the prediction lists in sensitivity_extra, moved; change of "
                          f"{_esc(next(c['response'] for c in r['comparisons'] if not c['inside']))}, paired by seed "
                          f"with the prediction, +- its standard error):</p><ul>")
             for x in r["sensitivity"][:6]:
-                change = "runs failed" if x["change"] is None else f"{x['change']:+.3g}"
+                change = f"{x['change']:+.3g}" if x["change"] is not None and not x.get("error") else \
+                    f"no result ({_esc(x.get('error') or 'runs failed')})"
                 if x["change"] is not None and x.get("change_se") is not None:
                     change += f" +- {x['change_se']:.2g}"
                     if abs(x["change"]) < 2 * x["change_se"]:
