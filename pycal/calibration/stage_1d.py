@@ -8,9 +8,10 @@
    to every run so far, invert it for the target (estimate, 95 % interval), and run
    the point that most shrinks the interval (pycal.stats.sequential.step_1d).
 A point the rig refuses becomes a limit: the bounds in use end halfway between it and
-the nearest point that ran. When the target then lies beyond that limit, the stage
-probes halfway between the limit and the refused point (a probe that runs moves the limit
-out to it, one refused moves it in), until the gap is below PROBE_GAP_U of the bounds.
+the nearest point that ran. When the target then lies beyond that limit (the stop rule
+says so, or the estimate sits on the limit), the stage probes halfway between the limit
+and the refused point (a probe that runs moves the limit out to it, one refused moves it
+in), until the gap is below PROBE_GAP_U of the bounds.
 The calibrated value is the estimate (4 significant digits).
 """
 import math
@@ -90,10 +91,15 @@ def run(study, material, st):
         return True
 
     def probe_past_limit(step):
-        """The target lies beyond a limit set by a refused point: the point halfway between
-        the limit and that refused point (bisection towards what the rig can run), or None
-        when the gap is below PROBE_GAP_U or no refused point lies beyond that limit."""
+        """The target lies beyond a limit set by a refused point (the stop rule says so, or
+        the estimate sits on that limit: the model clips it there while the seed noise keeps
+        the stop rule from calling it beyond): the point halfway between the limit and that
+        refused point (bisection towards what the rig can run), or None when the gap is
+        below PROBE_GAP_U or no refused point lies beyond that limit."""
         side = {stopping.BEYOND_LOWER: -1, stopping.BEYOND_UPPER: 1}.get(step.stop)
+        if side is None and not step.stop:
+            u = float(scale.to_unit(step.estimate))
+            side = -1 if u <= lo_u + 1e-9 else 1 if u >= hi_u - 1e-9 else None
         if side is None:
             return None
         limit = lo_u if side < 0 else hi_u
@@ -145,10 +151,10 @@ def run(study, material, st):
         return _one_point_row(study, st, target, response, xs, ys, budget_note)
     while True:
         step = decide(runs_left())
-        if step.stop:
-            probe = probe_past_limit(step) if runs_left() >= n else None
-            if probe is None:
-                break
+        probe = probe_past_limit(step) if runs_left() >= n else None
+        if step.stop and probe is None:
+            break
+        if probe is not None:
             study.log(f"  the target lies past the limit a refused point set: probing {p['label']} = {probe:.4g}")
             step.next_x = probe
         try:

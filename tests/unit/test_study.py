@@ -593,3 +593,42 @@ def test_a_root_between_the_limit_and_a_refused_point_is_found_by_probing(tmp_pa
     p = row["parameters"][0]
     assert any("probing" in m for m in logged)
     assert row["met"] and holds(p, root), row["message"]
+
+
+def test_an_estimate_clipped_at_a_refused_limit_probes_past_it(tmp_path):
+    """Seen in the seed-base-101 study: the rig refused rolling 0.02, the limit became 0.185
+    (halfway to 0.35), the root lay below it, and with AoR seed noise of ~5 deg the stop rule
+    never called the target beyond: the stage ran 0.185 nine times. Fake AoR = 30 + 60 x
+    rolling (root 0.133 for the lab's 38 deg), noise 8 deg, refused below 0.06: the stage
+    must probe below 0.185 and bracket the root."""
+    cfg = tmp_path / "roll.yaml"
+    cfg.write_text("""
+name: roll
+seeds_count: 3
+materials:
+  M3-dry:
+    - stage: rolling_resistance
+      rig: aor
+      response: aor_mean_deg
+      target: {sample: fines_dry, test: angle_of_repose, band_deg: 1.0}
+      parameter:
+        keys: [interactions.M3-dry.rolling_resistance_coefficient]
+        start: 0.35
+        bounds: [0.02, 1.5]
+        response_increases: true
+        tolerance_coefficient: 0.05
+      max_runs_count: 36
+""")
+    def aor(job):
+        return {"aor_mean_deg": 30.0 + 60.0 * job["materials"]["M3-dry"]["interactions"]["M3-dry"][
+            "rolling_resistance_coefficient"]}
+    ex = FakeRigs(results={"aor": aor}, noise={"aor_mean_deg": 8.0},
+                  refuse=lambda j: "no angle" if j["materials"]["M3-dry"]["interactions"]["M3-dry"][
+                      "rolling_resistance_coefficient"] < 0.06 else None)
+    (row,) = Study(cfg, ex, tmp_path / "out", log=quiet).run()
+    xs = [j["materials"]["M3-dry"]["interactions"]["M3-dry"]["rolling_resistance_coefficient"] for j in ex.asked]
+    assert 0.02 in xs                                              # refused: the limit
+    assert any(0.06 <= x < 0.18 for x in xs)                       # a probe below the halfway limit ran
+    p = row["parameters"][0]
+    root = (labdata.aor_target_deg("fines_dry") - 30.0) / 60.0
+    assert p["low"] < 0.18 and holds(p, root)
