@@ -601,24 +601,7 @@ def test_an_estimate_clipped_at_a_refused_limit_probes_past_it(tmp_path):
     never called the target beyond: the stage ran 0.185 nine times. Fake AoR = 30 + 60 x
     rolling (root 0.133 for the lab's 38 deg), noise 8 deg, refused below 0.06: the stage
     must probe below 0.185 and bracket the root."""
-    cfg = tmp_path / "roll.yaml"
-    cfg.write_text("""
-name: roll
-seeds_count: 3
-materials:
-  M3-dry:
-    - stage: rolling_resistance
-      rig: aor
-      response: aor_mean_deg
-      target: {sample: fines_dry, test: angle_of_repose, band_deg: 1.0}
-      parameter:
-        keys: [interactions.M3-dry.rolling_resistance_coefficient]
-        start: 0.35
-        bounds: [0.02, 1.5]
-        response_increases: true
-        tolerance_coefficient: 0.05
-      max_runs_count: 36
-""")
+    cfg = rolling_study(tmp_path, tolerance=0.05, max_runs=36)
     def aor(job):
         return {"aor_mean_deg": 30.0 + 60.0 * job["materials"]["M3-dry"]["interactions"]["M3-dry"][
             "rolling_resistance_coefficient"]}
