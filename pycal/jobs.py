@@ -59,16 +59,10 @@ def override_value(job, key):
     them). None for a rig or set key, or a path the job does not have."""
     if key.startswith("rig."):
         return None
-    head, _, rest = key.partition(".")
     if job.get("material_set") is not None:
-        node, parts = job["materials"].get(head), rest.split(".") if rest else []
-    else:
-        node, parts = job["materials"][job["material"]], key.split(".")
-    for part in parts:
-        if not isinstance(node, dict) or part not in node:
-            return None
-        node = node[part]
-    return node if parts else None
+        head, _, rest = key.partition(".")
+        return component_value(job["materials"], {"from": head, "key": rest})
+    return component_value(job["materials"], {"from": job["material"], "key": key})
 
 
 def resolve_job(rig, material, overrides=None, seed=1, config_dir=CONFIG_DIR):
@@ -79,13 +73,13 @@ def resolve_job(rig, material, overrides=None, seed=1, config_dir=CONFIG_DIR):
     """
     if isinstance(seed, bool) or not isinstance(seed, int) or seed < 0:
         raise ConfigError("--seed", "seed", f"{seed!r} must be a whole number >= 0")
+    # a copy: a subtree override (a dict) is put into the material as it is, and a leaf
+    # override below it then writes into it; the caller's dict must not change with it
+    overrides = copy.deepcopy(dict(overrides or {}))
     if material in material_set_names(config_dir):
         return resolve_set_job(rig, material, overrides, seed, config_dir)
     rig_cfg = load_rig(rig, config_dir)
     mat = copy.deepcopy(load_material(material, config_dir))
-    # a copy: a subtree override (a dict) is put into the material as it is, and a leaf
-    # override below it then writes into it; the caller's dict must not change with it
-    overrides = copy.deepcopy(dict(overrides or {}))
     for key, value in overrides.items():
         if key.startswith("rig."):
             _set_path(rig_cfg, key[4:], value, f"overrides of configs/rigs/{rig}.yaml")
@@ -121,9 +115,7 @@ def resolve_set_job(rig, set_name, overrides=None, seed=1, config_dir=CONFIG_DIR
     raw = load_yaml(Path(config_dir) / SET_DIR / f"{set_name}.yaml")
     known = {m: copy.deepcopy(load_material(m, config_dir)) for m in material_names(config_dir)}
     comps = list(raw.get("components") or {}) if isinstance(raw.get("components"), dict) else []
-    # a copy: a subtree override (a dict) is put into the material as it is, and a leaf
-    # override below it then writes into it; the caller's dict must not change with it
-    overrides = copy.deepcopy(dict(overrides or {}))
+    overrides = dict(overrides or {})
     set_keys = []
     for key, value in overrides.items():
         head = key.split(".", 1)[0]

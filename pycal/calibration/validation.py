@@ -84,6 +84,11 @@ def check(section, c, key="validation"):
                     c.fail(ck, "a scalar comparison needs one band_<unit> (the lab value's band)")
 
 
+def movable(value):
+    """A value the sensitivity can move by a relative step: a non-zero number."""
+    return isinstance(value, (int, float)) and not isinstance(value, bool) and value != 0
+
+
 def check_extra(p, c, k):
     """`sensitivity_extra`: keys of values no stage fits (start values) that the sensitivity
     moves too; each must address a non-zero number of the prediction's material (set)."""
@@ -96,7 +101,7 @@ def check_extra(p, c, k):
     job = resolve_job(p["rig"], p["material"], p.get("rig_overrides", {}))
     for x in keys:
         v = override_value(job, x)
-        if isinstance(v, bool) or not isinstance(v, (int, float)) or v == 0:
+        if not movable(v):
             c.fail(f"{k}.sensitivity_extra", f"{x}: not a non-zero number of {p['material']} (value {v!r})")
 
 
@@ -174,8 +179,7 @@ def sensitivity(study, pred, extra, cfg, base_by_seed, cmp):
     paired by seed with the prediction's runs (base_by_seed: {seed: result})."""
     step = cfg["relative_step_fraction"]
     seeds = study.seeds_from_base(cfg.get("seeds_count", 3))
-    values = [(k, v) for k, v in extra.items()
-              if not k.startswith("rig.") and isinstance(v, (int, float)) and not isinstance(v, bool) and v != 0]
+    values = [(k, v) for k, v in extra.items() if not k.startswith("rig.") and movable(v)]
     if pred.get("sensitivity_extra"):            # start values no stage fits, read from the job
         job = resolve_job(pred["rig"], pred["material"], extra)
         values += [(k, override_value(job, k)) for k in pred["sensitivity_extra"]]
