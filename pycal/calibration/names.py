@@ -12,8 +12,10 @@ QUANTITIES = {
     "youngs_modulus_pa": "Young's modulus",
     "friction_coefficient": "friction",
     "rolling_resistance_coefficient": "rolling resistance",
-    "cohesion.force_fraction": "cohesion force fraction",
-    "cohesion.pressure_fraction": "adhesion pressure fraction",
+    # the same law pulls particles together (cohesion, a material partner) and onto a
+    # wall (adhesion, a boundary partner): the partner in brackets says which
+    "cohesion.force_fraction": "pull-off weight fraction",
+    "cohesion.pressure_fraction": "pull-off pressure fraction",
 }
 PARTNER_LABELS = {"pvc": "PVC"}
 

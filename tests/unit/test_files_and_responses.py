@@ -44,5 +44,5 @@ def test_parameter_groups_are_named_for_people():
             "interactions.pvc.rolling_resistance_coefficient"]
     assert group_label(keys) == "rolling resistance (M2, steel, PVC)"
     assert group_label(["contact.youngs_modulus_pa"]) == "Young's modulus"
-    assert group_label(["interactions.steel.cohesion.pressure_fraction"]) == "adhesion pressure fraction (steel)"
+    assert group_label(["interactions.steel.cohesion.pressure_fraction"]) == "pull-off pressure fraction (steel)"
     assert unit_of_key("particles.density_kg_m3") == "kg_m3" and unit_of_key(keys[0]) == "coefficient"

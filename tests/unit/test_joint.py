@@ -54,7 +54,7 @@ def test_wet_wall_joint_stage_recovers_both_parameters_with_their_trade_off(tmp_
     rows = study.run()
     row = rows[0]
     fric, press = row["parameters"]
-    assert fric["label"] == "friction (steel)" and press["label"] == "adhesion pressure fraction (steel)"
+    assert fric["label"] == "friction (steel)" and press["label"] == "pull-off pressure fraction (steel)"
     assert holds(fric, 0.40) and abs(fric["estimate"] - 0.40) < 0.03
     assert holds(press, 0.0117) and abs(press["estimate"] - 0.0117) < 0.003
     # raising the friction lifts the whole curve; less adhesion must make up for it

@@ -115,7 +115,7 @@ def test_outputs_give_estimate_interval_runs_and_stop_reason_per_parameter(tmp_p
     table = list(csv.DictReader(open(out / "stages.csv")))
     assert [t["parameter"] for t in table] == ["particle density", "rolling resistance (M3-dry, steel, PVC)",
                                                "rolling resistance (M3-wet, steel, PVC)",
-                                               "cohesion force fraction (M3-wet)"]
+                                               "pull-off weight fraction (M3-wet)"]
     for t in table:
         assert float(t["interval_low"]) <= float(t["estimate"]) <= float(t["interval_high"])
         assert t["stop_reason"] and int(t["runs_requested"]) >= 0 and t["parameter_unit"]
