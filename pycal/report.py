@@ -188,7 +188,7 @@ def write_report(study_dir):
                                                  f"({_esc(s['stop_reason'])})" for s in not_met) + ".</p>")
     parts.append(f"<p class='muted'>{summary['runs_requested']} runs requested (cached runs are not simulated "
                  f"again), {summary['elapsed_s']:.0f} s; seeds from {summary['seed_base']}, "
-                 f"{len(summary['seeds'])} per new point; YADE {_esc(versions)}.</p>")
+                 f"{len(summary['seeds'])} per point, none used twice in a stage; YADE {_esc(versions)}.</p>")
     parts += ["<h2>Calibrated parameters</h2>", _stage_table(stages)]
     parts.append("<h2>Cost per material</h2><table><tr><th>material</th><th>runs requested</th>"
                  "<th>runs simulated</th><th>wall time s</th></tr>")

@@ -31,8 +31,8 @@ def _cmd_calibrate(args):
     # (a Dask executor stops the cluster it started when the process exits)
     study = Study(args.config, executor, Path(args.out or runs / "study"), seed_base=args.seed_base)
     t0 = time.time()
-    print(f"calibration study {study.cfg['name']} ({args.config}): {len(study.seeds)} seeds per new point "
-          f"(seeds {study.seeds[0]}, {study.seeds[0] + 1}, ...), runs cached in {runs}; interrupt at any time "
+    print(f"calibration study {study.cfg['name']} ({args.config}): {len(study.seeds)} seeds per point, "
+          f"new at every point of a stage (seeds {study.seeds[0]}, {study.seeds[0] + 1}, ...), runs cached in {runs}; interrupt at any time "
           f"and run again to resume")
     rows = study.run()
     report = write_report(study.out)

@@ -28,6 +28,8 @@ from .journal import Journal, fingerprint
 from .names import group_label, unit_of_key
 from .study_config import load_study
 
+SEED_SCHEME = "fresh seeds at every point"   # in the stage fingerprint: journals of the old scheme start afresh
+
 
 class BudgetSpent(PycalError):
     """The study's run budget (max_runs_count) does not allow the runs asked for."""
@@ -56,7 +58,11 @@ class Study:
         self.runs_requested = 0
         self.yade_versions = set()
         self.point_results = {}      # (material, stage, rig, point json) -> results of that point
-        self._point_seeds = {}       # same key -> seeds used there
+        # (material, stage, rig) -> seeds used in that stage: every point gets seeds not used
+        # before in its stage. The same seeds at every point would share each pour's offset
+        # (how many spheres fit the fill cell is the seed's: 3.4 % SD) across all of the
+        # stage's runs, which the response model takes as independent
+        self._stage_seeds = {}
         self.last_seeds = []         # seeds actually run by the last _run_seeds (replacements included)
         self.t0 = time.time()
         self.journal = Journal(self.out / "journal.json")
@@ -135,10 +141,11 @@ class Study:
 
     def run_point(self, material, stage, rig, extra, response, lab_dir, count=None):
         """Values of `response` (pycal.post.responses) at one parameter point: `count` runs
-        (default seeds_count) with the material's current overrides + `extra`. A point
-        run again in the same stage gets the next unused seeds (more runs there)."""
+        (default seeds_count) with the material's current overrides + `extra`. Every point
+        (and a point run again) gets its stage's next unused seeds on this rig: the stage's
+        runs are independent draws of the random fill."""
         key = (material, stage, rig, json.dumps(extra, sort_keys=True))
-        used = self._point_seeds.setdefault(key, [])
+        used = self._stage_seeds.setdefault((material, stage, rig), [])
         count = count or len(self.seeds)
         seeds = self.seeds[:count] if not used else list(range(max(used) + 1, max(used) + 1 + count))
         results = self._run_seeds(rig, material, {**self.overrides[material], **extra}, seeds)
@@ -194,7 +201,8 @@ class Study:
         its config, the seeds, its targets and the material's values so far."""
         tg = [t.__dict__ for t in self.targets[(material, st["label"])]]
         return self.journal.stage(f"{material}/{st['label']}",
-                                  fingerprint(st, self.seeds, sorted(self.overrides[material].items()), tg))
+                                  fingerprint(st, self.seeds, sorted(self.overrides[material].items()), tg,
+                                              SEED_SCHEME))
 
     def seeds_from_base(self, count):
         """`count` seeds from the study's seed base: seed_base, seed_base + 1, ..."""

@@ -50,13 +50,17 @@ materials:
 class FakeRigs:
     """run(jobs, raise_on_error) -> results like runner.LocalPool, with .simulated_count and
     .last_errors. results: {rig: function(job) -> dict of measurements}; noise: {key: sd}
-    (relative when the key is in relative); refuse(job) -> message or None."""
+    (relative when the key is in relative); seed_offsets: {key: relative sd} of an offset
+    that belongs to the seed and repeats at every point (a pour that holds more spheres
+    whatever the density); refuse(job) -> message or None."""
 
-    def __init__(self, results=None, noise=None, relative=("bulk_density_kg_m3",), refuse=None, cache=None):
+    def __init__(self, results=None, noise=None, relative=("bulk_density_kg_m3",), refuse=None, cache=None,
+                 seed_offsets=None):
         self.results = {"fill": lambda j: {"bulk_density_kg_m3": bulk_law(j)},
                         "aor": lambda j: {"aor_mean_deg": aor_law(j)}, **(results or {})}
         self.noise = {"bulk_density_kg_m3": 0.005, "aor_mean_deg": 0.5, **(noise or {})}
         self.relative = relative
+        self.seed_offsets = seed_offsets or {}
         self.refuse = refuse or (lambda job: None)
         self.cache = {} if cache is None else cache
         self.simulated_count, self.last_errors, self.asked = 0, [], []
@@ -79,6 +83,9 @@ class FakeRigs:
             for k, sd in self.noise.items():
                 if isinstance(r.get(k), float):
                     r[k] = r[k] * (1 + sd * rng.gauss(0, 1)) if k in self.relative else r[k] + sd * rng.gauss(0, 1)
+            for k, sd in self.seed_offsets.items():
+                if isinstance(r.get(k), float):
+                    r[k] *= 1 + sd * random.Random(f"seed {job['seed']}").gauss(0, 1)
             r.update({"rig": job["rig"], "material": job["material"], "seed": job["seed"], "job": job,
                       "job_id": job["job_id"], "provenance": {"yade_version": YADE_VERSION}})
             self.cache[job["job_id"]] = r
