@@ -14,6 +14,9 @@ import json
 import sys
 from pathlib import Path
 
+sys.path.insert(0, str(Path(__file__).resolve().parent.parent))
+from pycal.files import write_text  # noqa: E402  (atomic: no half-written table)
+
 
 def parameter_rows(summary):
     """{(material, stage, parameter label): parameter dict + stop reason} of one summary.json."""
@@ -47,9 +50,9 @@ def compare(summary_a, summary_b):
         if a is not None and b is not None and a["stop_reason"].startswith("inherited"):
             verdict = "(inherited)"
         elif a is not None and b is not None:
-            n_both += 1
-            n_overlap += overlap(a, b)
-            verdict = "yes" if overlap(a, b) else "**no**"
+            both = overlap(a, b)
+            n_both, n_overlap = n_both + 1, n_overlap + both
+            verdict = "yes" if both else "**no**"
         lines.append(f"| {k[0]} | {k[1]} | {k[2]} | {_fmt(a)} | {_fmt(b)} | {verdict} |")
     lines.append("")
     lines.append(f"{n_overlap} of {n_both} parameters calibrated by both runs have overlapping 95 % intervals.")
@@ -79,7 +82,7 @@ def main(argv=None):
     text = "\n".join(lines) + "\n"
     print(text, end="")
     if args.out:
-        Path(args.out).write_text(text)
+        write_text(args.out, text)
     return 0
 
 
