@@ -1,18 +1,14 @@
 """bench/seed_base_compare.py: which calibrated intervals of two seed bases overlap."""
-import importlib.util
 import json
 
 import pytest
 
-from pycal import REPO_ROOT
+from bench_scripts import load_bench_script
 
 
 @pytest.fixture(scope="module")
 def compare():
-    spec = importlib.util.spec_from_file_location("seed_base_compare", REPO_ROOT / "bench" / "seed_base_compare.py")
-    mod = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(mod)
-    return mod
+    return load_bench_script("seed_base_compare")
 
 
 def _summary(seed_base, params):

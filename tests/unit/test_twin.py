@@ -1,21 +1,17 @@
 """bench/twin.py bookkeeping with a fake executor (no YADE): hidden values from the command
 line or a YAML list, targets with their standard errors, per-parameter error and whether
 the hidden value lies inside the 95 % interval, the markdown table."""
-import importlib.util
 import json
 
 import pytest
 
+from bench_scripts import load_bench_script
 from fake_rigs import FakeRigs
-from pycal import REPO_ROOT
 
 
 @pytest.fixture(scope="module")
 def twin():
-    spec = importlib.util.spec_from_file_location("twin_bench", REPO_ROOT / "bench" / "twin.py")
-    mod = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(mod)
-    return mod
+    return load_bench_script("twin")
 
 
 def test_a_twin_from_the_command_line_recovers_its_hidden_values(twin, tmp_path):
