@@ -166,9 +166,11 @@ def simulate_targets(executor, hidden, seeds, lab):
     return out
 
 
-def twin_study(name, hidden, targets, seeds_count, final_pass=True):
+def twin_study(name, hidden, targets, seeds_count, final_pass=True, target_seeds_count=3):
     """The study config (a dict) of one twin: the shipped M2 stages for the hidden
-    parameters, targets set to the twin's (with their standard errors)."""
+    parameters, targets set to the twin's (with their standard errors, each estimated
+    from target_seeds_count seeds: the inversion draws the target from a Student-t)."""
+    n = {"standard_error_seeds_count": int(target_seeds_count)}
     shipped = yaml.safe_load(SHIPPED.read_text())["materials"][MATERIAL]
     by_label = {st.get("name", st["stage"]): st for st in shipped}
     stages = []
@@ -180,10 +182,10 @@ def twin_study(name, hidden, targets, seeds_count, final_pass=True):
         value, se = targets[response]
         unit = responses.get(response).unit
         band = {k: v for k, v in st.get("target", {}).items() if k.startswith("band_")}
-        st["target"] = {"value": round(float(value), 6), f"standard_error_{unit}": round(float(se), 6), **band}
+        st["target"] = {"value": round(float(value), 6), f"standard_error_{unit}": round(float(se), 6), **n, **band}
         if label in ("stiffness", "wall_friction"):
             st["lab_dir"] = "twin_lab"
-            st["target"] = {"value": 0.0, f"standard_error_{unit}": round(float(se), 6), **band}
+            st["target"] = {"value": 0.0, f"standard_error_{unit}": round(float(se), 6), **n, **band}
         stages.append(st)
     if final_pass and {"particle_density_kg_m3", "rolling_resistance_coefficient"} <= set(hidden):
         st = json.loads(json.dumps(by_label["rolling_density_final"]))
@@ -191,7 +193,8 @@ def twin_study(name, hidden, targets, seeds_count, final_pass=True):
             value, se = targets[r["response"]]
             unit = responses.get(r["response"]).unit
             band = {k: v for k, v in r.get("target", {}).items() if k.startswith("band_")}
-            r["target"] = {"value": round(float(value), 6), f"standard_error_{unit}": round(float(se), 6), **band}
+            r["target"] = {"value": round(float(value), 6), f"standard_error_{unit}": round(float(se), 6), **n,
+                           **band}
         stages.append(st)
     return {"name": name, "description": f"synthetic twin (bench/twin.py), hidden {json.dumps(hidden)}",
             "seeds_count": seeds_count, "max_runs_count": 600, "materials": {MATERIAL: stages}}
@@ -225,7 +228,7 @@ def run_twin(name, hidden, executor, out, seeds_count=3, target_seeds_count=3, s
     t_targets = time.time() - t0
     cfg = folder / "twin.yaml"
     write_text(cfg, "# written by bench/twin.py\n" + yaml.safe_dump(
-        twin_study(name, hidden, targets, seeds_count, final_pass), sort_keys=False))
+        twin_study(name, hidden, targets, seeds_count, final_pass, target_seeds_count), sort_keys=False))
     load_study(cfg)
     study = Study(cfg, executor, folder / "study", log=log, seed_base=seed_base)
     t1 = time.time()

@@ -117,7 +117,7 @@ def run(study, material, st):
                        tolerance=None if p["tolerance_is_percent"] else p["tolerance"],
                        tolerance_percent=p["tolerance"] if p["tolerance_is_percent"] else None,
                        standard_error=target.standard_error, band=target.band, runs_left=runs,
-                       runs_per_point=n, lo_u=lo_u, hi_u=hi_u)
+                       runs_per_point=n, lo_u=lo_u, hi_u=hi_u, standard_error_dof=target.standard_error_dof)
 
     while (x := jr.next_recorded()) is not None:        # a resumed study: the same points again
         point(x, replay=True)

@@ -95,8 +95,9 @@ def run(study, material, st):
         # one target per output (a vector response has several), known once a point ran
         targets = [t.value for t, w in zip(tgts, widths) for _ in range(w)]
         ses = [t.standard_error for t, w in zip(tgts, widths) for _ in range(w)]
+        dofs = [t.standard_error_dof for t, w in zip(tgts, widths) for _ in range(w)]
         return step_nd(scales, X, Y, targets, ses, tols, runs_left=runs, runs_per_point=per_point,
-                       avoid_x=[x for x, _ in refused])
+                       avoid_x=[x for x, _ in refused], standard_error_dofs=dofs)
 
     if jr.result:
         step = decide(0)

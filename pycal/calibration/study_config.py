@@ -22,7 +22,9 @@ A parameter group:
 A target: {value: X} | {sample: KEY, test: angle_of_repose} | {} (bulk density: the
 material's lab sample), with optional band_<unit> (the lab band: plotted, and the
 parameter range it allows) and standard_error_<unit> (the target is itself a mean,
-e.g. a twin's: widens the interval), <unit> = the response's unit.
+e.g. a twin's: widens the interval), <unit> = the response's unit, with
+standard_error_seeds_count (how many values that standard error was estimated from:
+the target is then drawn from a Student-t with n - 1 degrees of freedom).
 """
 import copy
 from pathlib import Path
@@ -127,7 +129,8 @@ def _target(c, t, key, response):
     if not isinstance(t, dict):
         c.fail(key, "must be a mapping: {value: X} or {sample: KEY, test: NAME}, with optional band_<unit>")
     unit = response.unit
-    allowed = ["value", "sample", "test", f"band_{unit}", "band_percent", f"standard_error_{unit}"]
+    allowed = ["value", "sample", "test", f"band_{unit}", "band_percent", f"standard_error_{unit}",
+               "standard_error_seeds_count"]
     for k in t:
         if k not in allowed:
             hint = (f" (this response is in {unit}: band_{unit}, standard_error_{unit})"
@@ -146,6 +149,13 @@ def _target(c, t, key, response):
     for k in (f"band_{unit}", "band_percent", f"standard_error_{unit}"):
         if k in t:
             c.number(t[k], f"{key}.{k}", 0)
+    if "standard_error_seeds_count" in t:
+        n = t["standard_error_seeds_count"]
+        if isinstance(n, bool) or not isinstance(n, int) or n < 2:
+            c.fail(f"{key}.standard_error_seeds_count", f"{n!r} must be a whole number >= 2 (a standard error "
+                                                         f"needs two values)")
+        if f"standard_error_{unit}" not in t:
+            c.fail(f"{key}.standard_error_seeds_count", f"goes with standard_error_{unit}, which is missing")
     if f"band_{unit}" in t and "band_percent" in t:
         c.fail(f"{key}.band_percent", f"give band_{unit} or band_percent, not both")
     if "band_percent" in t and "value" in t and t["value"] == 0:

@@ -3,6 +3,7 @@
 Read once when the study starts, so a broken lab file stops the study before any run,
 with the file, key and reason (never a silent stand-in value).
 """
+import math
 from dataclasses import dataclass
 
 from .. import LAB_DIR, labdata
@@ -16,6 +17,13 @@ class Target:
     band: float              # half width of the lab band (0: none given)
     standard_error: float    # of the target itself (0: taken as exact)
     source: str              # where the value comes from, for the report
+    standard_error_seeds_count: int = 0   # values the standard error was estimated from (0: known)
+
+    @property
+    def standard_error_dof(self):
+        """Degrees of freedom of the standard error: n - 1 for a mean of n values, inf when known."""
+        n = self.standard_error_seeds_count
+        return n - 1 if n >= 2 else math.inf
 
 
 def lab_bulk_density(material, lab_dir=None):
@@ -39,4 +47,5 @@ def resolve(spec, response, material, lab_dir=None):
         value, sample = lab_bulk_density(material, lab_dir)
         source = f"lab {sample} bulk density"
     band = float(spec.get(f"band_{unit}", abs(value) * float(spec.get("band_percent", 0.0)) / 100.0))
-    return Target(value, band, float(spec.get(f"standard_error_{unit}", 0.0)), source)
+    return Target(value, band, float(spec.get(f"standard_error_{unit}", 0.0)), source,
+                  int(spec.get("standard_error_seeds_count", 0)))

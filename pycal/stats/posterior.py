@@ -6,16 +6,20 @@ within the surrogate's own uncertainty of its mean response:
 
     log p(u) = sum_k log N(target_k; mean_k(u), var_k(u) + standard_error_k^2)
 
+or, for a target whose standard error was estimated from a few values (dof_k degrees of
+freedom), a Student-t with dof_k degrees of freedom and that scale in place of N.
 with a flat prior on the unit box (flat in the parameter, or in its log). emcee's
 affine-invariant ensemble sampler draws from it; the estimate is the median of each
 parameter, its 95 % interval the 2.5 - 97.5 percentiles, and the correlation matrix
 says how the parameters trade off (e.g. friction against adhesion on one wall curve).
 """
+import math
 from dataclasses import dataclass
 
 import emcee
 import numpy as np
 from scipy.optimize import minimize
+from scipy.special import gammaln
 from .threads import single_threaded
 
 WALKERS_COUNT = 24
@@ -37,24 +41,30 @@ class Posterior:
     acceptance: float
 
 
-def log_likelihood(models, targets, standard_errors, U):
-    """log p(targets | u) for each row of U (n x d); -inf outside the unit box."""
+def log_likelihood(models, targets, standard_errors, U, dofs=None):
+    """log p(targets | u) for each row of U (n x d); -inf outside the unit box.
+    dofs: per target, the degrees of freedom of its standard error (None / inf: known)."""
     U = np.atleast_2d(U)
     out = np.full(len(U), -np.inf)
     inside = np.all((U >= 0.0) & (U <= 1.0), axis=1)
     if inside.any():
         total = np.zeros(int(inside.sum()))
-        for m, t, se in zip(models, targets, standard_errors):
+        dofs = [math.inf] * len(models) if dofs is None else dofs
+        for m, t, se, dof in zip(models, targets, standard_errors, dofs):
             mu, var = m.mean_var(U[inside])
             s2 = var + se ** 2 + 1e-300
-            total += -0.5 * (t - mu) ** 2 / s2 - 0.5 * np.log(2 * np.pi * s2)
+            if math.isinf(dof):
+                total += -0.5 * (t - mu) ** 2 / s2 - 0.5 * np.log(2 * np.pi * s2)
+            else:
+                total += (gammaln(0.5 * (dof + 1)) - gammaln(0.5 * dof) - 0.5 * np.log(dof * np.pi * s2)
+                          - 0.5 * (dof + 1) * np.log1p((t - mu) ** 2 / (dof * s2)))
         out[inside] = total
     return out
 
 
 @single_threaded
 def sample(models, targets, standard_errors, start_u, seed=0, walkers=WALKERS_COUNT, steps=STEPS_COUNT,
-           burn=BURN_COUNT, keep=KEEP_COUNT):
+           burn=BURN_COUNT, keep=KEEP_COUNT, dofs=None):
     """Posterior over u from the outputs' response models; start_u: points to start the
     search from (one, or rows: e.g. every point run so far).
 
@@ -68,7 +78,7 @@ def sample(models, targets, standard_errors, start_u, seed=0, walkers=WALKERS_CO
     d = models[0].dim
 
     def log_p(U):
-        return log_likelihood(models, targets, standard_errors, U)
+        return log_likelihood(models, targets, standard_errors, U, dofs)
     rng = np.random.default_rng(seed)
     # the most likely point: local searches from the best few of start_u and random points
     # (the surrogate's vague edges can hold local maxima: one search from one start is not enough)

@@ -5,6 +5,7 @@ far (every seed of every point) -> response model(s) -> inversion or posterior -
 stop rule -> next point. Values in the parameters' own units (x); the models work on
 u in [0, 1] (pycal.stats.scales).
 """
+import math
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -52,7 +53,7 @@ def second_point_u(u0, y0, target, increasing, slope_per_u=None, lo_u=0.0, hi_u=
 
 @single_threaded
 def step_1d(scale, x, y, target, increasing, tolerance=None, tolerance_percent=None, standard_error=0.0,
-            band=0.0, runs_left=None, runs_per_point=3, lo_u=0.0, hi_u=1.0, seed=0):
+            band=0.0, runs_left=None, runs_per_point=3, lo_u=0.0, hi_u=1.0, seed=0, standard_error_dof=math.inf):
     """Decide after the runs (x, y) of a 1-D stage (at least two distinct x).
 
     tolerance: in x's unit, or tolerance_percent of the estimate; lo_u, hi_u: the bounds
@@ -60,7 +61,7 @@ def step_1d(scale, x, y, target, increasing, tolerance=None, tolerance_percent=N
     u = scale.to_unit(np.asarray(x, dtype=float))
     model = ResponseModel(u[:, None], y)
     inv = invert(model, target, increasing, standard_error=standard_error, band=band, lo_u=lo_u, hi_u=hi_u,
-                 rng=np.random.default_rng(seed))
+                 rng=np.random.default_rng(seed), standard_error_dof=standard_error_dof)
     est, low, high = (float(scale.from_unit(v)) for v in (inv.estimate_u, inv.low_u, inv.high_u))
     tol = tolerance if tolerance is not None else abs(est) * tolerance_percent / 100.0
     edge = 0.01 * (hi_u - lo_u)
@@ -93,24 +94,27 @@ class StepND:
 
 @single_threaded
 def step_nd(scales, X, Y, targets, standard_errors, tolerances, runs_left=None, runs_per_point=3,
-            avoid_x=(), seed=0, **sampler_kw):
+            avoid_x=(), seed=0, standard_error_dofs=None, **sampler_kw):
     """Decide after the runs of a joint stage.
 
     X: runs x d parameters (x units); Y: runs x outputs (NaN where a run gave no value);
-    targets, standard_errors: per output; tolerances: per parameter, (value, is_percent)."""
+    targets, standard_errors (and their degrees of freedom, standard_error_dofs; None:
+    known exactly): per output; tolerances: per parameter, (value, is_percent)."""
     X = np.asarray(X, dtype=float)
     Y = np.asarray(Y, dtype=float).reshape(len(X), -1)
     U = np.column_stack([s.to_unit(X[:, j]) for j, s in enumerate(scales)])
-    models, tgt, ses = [], [], []
+    dofs_in = [math.inf] * Y.shape[1] if standard_error_dofs is None else standard_error_dofs
+    models, tgt, ses, dofs = [], [], [], []
     for k in range(Y.shape[1]):
         ok = np.isfinite(Y[:, k])
         if ok.sum() >= 2 and len(group_rows(U[ok])) >= 2:
             models.append(ResponseModel(U[ok], Y[ok, k]))
             tgt.append(targets[k])
             ses.append(standard_errors[k])
+            dofs.append(dofs_in[k])
     if not models:
         raise ValueError("no output has values at two distinct points")
-    post = posterior.sample(models, tgt, ses, np.unique(U, axis=0), seed=seed, **sampler_kw)
+    post = posterior.sample(models, tgt, ses, np.unique(U, axis=0), seed=seed, dofs=dofs, **sampler_kw)
     S = np.column_stack([s.from_unit(post.samples_u[:, j]) for j, s in enumerate(scales)])
     est = [float(v) for v in np.median(S, axis=0)]
     low = [float(v) for v in np.percentile(S, 2.5, axis=0)]

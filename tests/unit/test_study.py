@@ -272,6 +272,12 @@ def test_bad_study_configs_name_file_key_and_reason(tmp_path, study_file):
         ("interactions.pvc.rolling_resistance_coefficient]\n        start",
          "interactions.pvc.rolling_resistance_coefficent]\n        start",
          r"parameter.keys: interactions.pvc.rolling_resistance_coefficent: no such key"),
+        ("band_deg: 1.0}\n      parameter:\n        keys",
+         "band_deg: 1.0, standard_error_seeds_count: 3}\n      parameter:\n        keys",
+         r"target.standard_error_seeds_count: goes with standard_error_deg, which is missing"),
+        ("band_deg: 1.0}\n      parameter:\n        keys",
+         "band_deg: 1.0, standard_error_deg: 2.0, standard_error_seeds_count: 1}\n      parameter:\n        keys",
+         r"target.standard_error_seeds_count: 1 must be a whole number >= 2"),
     ]
     for old, new, message in cases:
         assert old in STUDY, old

@@ -41,6 +41,7 @@ def test_a_twin_from_the_command_line_recovers_its_hidden_values(twin, tmp_path)
     # the twin's study file is a valid study config that names the targets' standard errors
     cfg = (tmp_path / "twin" / "twin.yaml").read_text()
     assert "standard_error_deg" in cfg and "standard_error_kg_m3" in cfg
+    assert cfg.count("standard_error_seeds_count: 3") == 4      # density, AoR, final pass's fill and AoR
 
 
 def test_a_list_of_twins_from_yaml(twin, tmp_path):
