@@ -123,7 +123,22 @@ def simulate_targets(executor, hidden, seeds, lab):
     o = hidden_overrides(hidden)
 
     def run(rig, extra=None):
-        return executor.run([resolve_job(rig, MATERIAL, {**o, **(extra or {})}, seed=s) for s in seeds])
+        """One result per target seed; a seed the rig refuses is replaced by the next one above
+        them (as the study replaces its own), at most as many times as there are seeds."""
+        results, batch, next_seed = [], list(seeds), max(seeds) + 1
+        while batch:
+            out = executor.run([resolve_job(rig, MATERIAL, {**o, **(extra or {})}, seed=s) for s in batch],
+                               raise_on_error=False)
+            results += [r for r in out if r is not None]
+            refused = len(batch) - sum(r is not None for r in out)
+            if refused:
+                print(f"twin: {rig}: {refused} target seed(s) refused: {getattr(executor, 'last_errors', [])}; "
+                      f"replaced from seed {next_seed}", file=sys.stderr)
+            if next_seed + refused > max(seeds) + 1 + len(seeds):
+                raise TwinError(f"{rig}: more than {len(seeds)} target seeds refused at the hidden values")
+            batch = list(range(next_seed, next_seed + refused))
+            next_seed += refused
+        return results
     (lab / "curves").mkdir(parents=True, exist_ok=True)
     out = {}
     if {"particle_density_kg_m3", "rolling_resistance_coefficient"} & set(hidden):
@@ -297,8 +312,12 @@ def main(argv=None, executor=None, results=RESULTS, commit=None):
         commit = git_commit(short=True)
     summaries = []
     for name, hidden in twins:
-        s = run_twin(name, hidden, executor, out, args.seeds_count, args.target_seeds_count, args.seed_base,
-                     not args.no_final_pass)
+        try:
+            s = run_twin(name, hidden, executor, out, args.seeds_count, args.target_seeds_count, args.seed_base,
+                         not args.no_final_pass)
+        except TwinError as exc:
+            print(f"twin: {name}: {exc}", file=sys.stderr)
+            return 2
         s.update({"git_commit": commit, "host": platform.node(),
                   "date_utc": datetime.datetime.now(datetime.timezone.utc).isoformat(timespec="seconds")})
         summaries.append(s)

@@ -82,3 +82,15 @@ def test_bad_twin_definitions_exit_2_with_one_line(twin, tmp_path, capsys, argv,
     err = capsys.readouterr().err
     assert code == 2 and message in err and len(err.strip().splitlines()) == 1
     assert not (tmp_path / "r.jsonl").exists()
+
+
+def test_a_refused_target_seed_is_replaced_by_the_next_one(twin, tmp_path):
+    """Seed 102 of the hidden fill is refused: the target is the mean of seeds 101, 103, 104."""
+    ex = FakeRigs(refuse=lambda job: "blow-up" if job["seed"] == 102 else None)
+    lab = tmp_path / "lab"
+    out = twin.simulate_targets(ex, {"particle_density_kg_m3": 3600.0}, [101, 102, 103], lab)
+    assert [j["seed"] for j in ex.asked] == [101, 102, 103, 104]
+    assert out["bulk_density_kg_m3"][1] > 0
+    never = FakeRigs(refuse=lambda job: "blow-up")
+    with pytest.raises(twin.TwinError, match="fill: more than 3 target seeds refused"):
+        twin.simulate_targets(never, {"particle_density_kg_m3": 3600.0}, [101, 102, 103], tmp_path / "lab2")
