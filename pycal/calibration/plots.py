@@ -14,6 +14,7 @@ from pathlib import Path
 import numpy as np
 
 from ..plotting import pyplot, save_png
+from ..stats.inversion import target_factor_95
 from .names import unit_label
 
 
@@ -44,6 +45,12 @@ def stage_1d(study, material, st, row, scale, xs, ys, step, target, response):
         ax.axhspan(target.value - target.band, target.value + target.band, color="tab:green", alpha=0.18,
                    label=f"lab target {target.value:.4g} +- {target.band:.3g}")
     ax.axhline(target.value, color="tab:green", lw=1.2, label=None if target.band > 0 else f"target {target.value:.4g}")
+    if target.standard_error > 0:        # the target is itself a mean (a twin's): its own 95 % range
+        half = target.standard_error * target_factor_95(target.standard_error_dof)
+        n = target.standard_error_seeds_count
+        ax.axhline(target.value - half, color="tab:green", lw=0.9, ls="--",
+                   label=f"target's own 95 % range +- {half:.3g}" + (f" (mean of {n} seeds)" if n else ""))
+        ax.axhline(target.value + half, color="tab:green", lw=0.9, ls="--")
     ax.fill_between(grid_x, mean - 1.96 * np.sqrt(var), mean + 1.96 * np.sqrt(var), color="tab:blue", alpha=0.2,
                     label="fitted mean response, 95 % band")
     ax.plot(grid_x, mean, color="tab:blue", lw=1.5)

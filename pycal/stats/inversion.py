@@ -19,6 +19,7 @@ import math
 from dataclasses import dataclass
 
 import numpy as np
+from scipy.stats import norm, t as student_t
 from .threads import single_threaded
 
 GRID_COUNT = 101
@@ -91,6 +92,12 @@ def target_noise(rng, draws, dof=math.inf):
     """Draws of (target - true mean) / standard error: standard normal when the standard
     error is known, Student-t with `dof` degrees of freedom when it was estimated."""
     return rng.standard_normal(draws) if math.isinf(dof) else rng.standard_t(float(dof), draws)
+
+
+def target_factor_95(dof=math.inf):
+    """Half width of the target's own 95 % range in standard errors: 1.96 for a known
+    standard error, the Student-t quantile for an estimated one (4.30 at 2 degrees of freedom)."""
+    return float(student_t.ppf(0.975, dof)) if not math.isinf(dof) else float(norm.ppf(0.975))
 
 
 def _mean_crossing(model, grid, level, increasing):

@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 
 from pycal.stats.gp import ResponseModel
-from pycal.stats.inversion import crossings, invert
+from pycal.stats.inversion import crossings, invert, target_factor_95
 
 DRAWS = 150          # binomial sd of a 95 % coverage over 150 draws: 1.8 % (fixed seeds: deterministic)
 
@@ -91,6 +91,13 @@ def test_coverage_on_a_saturating_curve():
     print(f"saturating curve: coverage {cov:.3f} (halved interval {cov_half:.3f}), median width {width:.3f}")
     assert 0.90 <= cov <= 0.99
     assert cov_half <= cov - 0.05
+
+
+def test_the_targets_own_95_percent_range_is_the_table_value():
+    """Student-t quantiles from the tables: 4.303 (2 degrees of freedom), 2.262 (9); normal 1.960."""
+    assert target_factor_95(2) == pytest.approx(4.303, abs=1e-3)
+    assert target_factor_95(9) == pytest.approx(2.262, abs=1e-3)
+    assert target_factor_95() == pytest.approx(1.960, abs=1e-3)
 
 
 def test_a_standard_error_estimated_from_three_seeds_needs_the_student_t():
