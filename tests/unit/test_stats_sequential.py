@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 
 from pycal.stats import stopping
-from pycal.stats.design import next_point_1d
+from pycal.stats.design import next_point_1d, next_point_nd
 from pycal.stats.gp import ResponseModel
 from pycal.stats.inversion import invert
 from pycal.stats.scales import Scale
@@ -142,9 +142,14 @@ def test_joint_next_point_is_inside_the_posterior_and_avoids_refused_points():
                  runs_left=30)
     assert st.stop is None
     assert all(lo <= x <= hi for lo, x, hi in zip(st.low, st.next_x, st.high))
-    again = step_nd([Scale(0, 1), Scale(0, 1)], X, Y, wall(TRUTH[None])[0], [0, 0], [(0.005, False)] * 2,
-                    runs_left=30, avoid_x=[st.next_x])
-    assert np.linalg.norm(np.array(again.next_x) - np.array(st.next_x)) > 0.03
+    # the rig refuses that point: the next candidate lies outside the ball ruled out around it
+    # (on the unit scales x = u); a ball over the whole posterior leaves no candidate
+    refused = np.array(st.next_x)
+    for radius in (0.03, 0.05):
+        nxt = next_point_nd(st.models, st.samples, 3, np.random.default_rng(0), avoid=[(refused, radius)])
+        assert np.linalg.norm(nxt - refused) > radius
+        assert all(lo <= x <= hi for lo, x, hi in zip(st.low, nxt, st.high))
+    assert next_point_nd(st.models, st.samples, 3, np.random.default_rng(0), avoid=[(refused, 1.5)]) is None
 
 
 def test_joint_posterior_coverage_over_random_draws():
