@@ -6,8 +6,8 @@ within the surrogate's own uncertainty of its mean response:
 
     log p(u) = sum_k log N(target_k; mean_k(u), var_k(u) + standard_error_k^2)
 
-or, for a target whose standard error was estimated from a few values (dof_k degrees of
-freedom), a Student-t with dof_k degrees of freedom and that scale in place of N.
+(for a target whose standard error was estimated from a few values, dof_k degrees of
+freedom: a Student-t with dof_k degrees of freedom and that scale in place of N),
 with a flat prior on the unit box (flat in the parameter, or in its log). emcee's
 affine-invariant ensemble sampler draws from it; the estimate is the median of each
 parameter, its 95 % interval the 2.5 - 97.5 percentiles, and the correlation matrix
