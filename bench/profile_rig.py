@@ -54,7 +54,7 @@ def main():
             setattr(O, name, value)
 
     proxy = _TimedO()
-    for extra in ("scene", "rigs", "loading", "compression", "tilt", "tilt_test", "tilt_bodies", "mixed"):
+    for extra in ("phase_clock", "scene", "rigs", "loading", "compression", "tilt", "tilt_test", "tilt_bodies", "mixed"):
         importlib.import_module("yade_scripts.demlib." + extra)
     for name in list(sys.modules):
         m = sys.modules[name]

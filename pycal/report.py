@@ -130,20 +130,7 @@ def _validation(study_dir, rows):
                          f"<td>{'inside the lab band' if c['inside'] else 'missed'}</td></tr>")
     parts.append("</table>")
     for r in rows:
-        if r.get("sensitivity"):
-            parts.append(f"<p>{_esc(r['prediction'])}: what drives the miss (each calibrated value, and each start "
-                         f"value the prediction lists in sensitivity_extra, moved; change of "
-                         f"{_esc(next(c['response'] for c in r['comparisons'] if not c['inside']))}, paired by seed "
-                         f"with the prediction, +- its standard error):</p><ul>")
-            for x in r["sensitivity"][:6]:
-                change = f"{x['change']:+.3g}" if x["change"] is not None and not x.get("error") else \
-                    f"no result ({_esc(x.get('error') or 'runs failed')})"
-                if x["change"] is not None and x.get("change_se") is not None:
-                    change += f" +- {x['change_se']:.2g}"
-                    if abs(x["change"]) < 2 * x["change_se"]:
-                        change += " (within 2 standard errors of 0: seed noise)"
-                parts.append(f"<li>{_esc(x['parameter'])} {_num(x['value'])} -> {_num(x['moved_to'])}: {change}</li>")
-            parts.append("</ul>")
+        parts += _sensitivity_section(study_dir, r)
         if r.get("plot") and (study_dir / r["plot"]).is_file():
             parts.append(_img(study_dir, r["plot"]))
     return parts
@@ -220,3 +207,31 @@ def write_report(study_dir):
                  f"<details><summary>study config</summary><pre>{_esc(json.dumps(cfg, indent=1))}</pre></details>"
                  "</body></html>")
     return write_text(study_dir / "report.html", "\n".join(parts))
+
+
+def _sensitivity_section(study_dir, r):
+    """What drives a prediction's miss: the latest `pycal sensitivity` output of it, if
+    any (screening first), else the command that finds it."""
+    for design in ("screening", "one-at-a-time"):
+        path = study_dir / f"sensitivity-{r['prediction']}-{design}.json"
+        if path.is_file():
+            data = json.loads(path.read_text())
+            parts = [f"<p>{_esc(r['prediction'])}: what drives {_esc(data['response'])} ({_esc(design)} design, "
+                     f"each value x{1 + data['relative_step_fraction']:g}, +- its standard error; "
+                     f"<code>{_esc(path.name)}</code>):</p><ul>"]
+            for x in data["factors"][:6]:
+                eff = "no result" if x.get("effect") is None else f"{x['effect']:+.3g}"
+                if x.get("effect") is not None and x.get("effect_se") is not None:
+                    eff += f" +- {x['effect_se']:.2g}"
+                    if abs(x["effect"]) < 2 * x["effect_se"]:
+                        eff += " (within 2 standard errors of 0: seed noise)"
+                parts.append(f"<li>{_esc(x['label'])} {_num(x['value'])} -> {_num(x['moved_to'])}: {eff}</li>")
+            parts.append("</ul>")
+            plot = Path("plots") / f"sensitivity-{r['prediction']}-{design}.png"
+            if (study_dir / plot).is_file():
+                parts.append(_img(study_dir, str(plot)))
+            return parts
+    if r.get("sensitivity_command"):
+        return [f"<p>{_esc(r['prediction'])} missed; what drives it: <code>{_esc(r['sensitivity_command'])}"
+                f"</code> (not part of the main job)</p>"]
+    return []

@@ -126,7 +126,9 @@ def _tilt_phases(p, wait, settle_key):
     n = len(p["consolidation_stresses_pa"])
     per_step_waits = 3 + (1 if p["settle_before_tilt"] else 0)
     max_tilt, hold = p["max_tilt_deg"], p["dynamic_max_time_s"]
-    tilt = max_tilt / p["tilt_rate_deg_s"] + max_tilt / p["tilt_restart_rate_deg_s"] + 2 * hold
+    tilt = max_tilt / p["tilt_rate_deg_s"] + hold
+    if p["measure_dynamic_friction"]:
+        tilt += max_tilt / p["tilt_restart_rate_deg_s"] + hold
     out = [(f"load, unload, settle ({n} steps x {per_step_waits} rest waits)", n * per_step_waits * wait, settle_key),
            (f"tilt to {max_tilt:g} deg and hold ({n} steps)", n * tilt, "rig.procedure.tilt_rate_deg_s")]
     if p["fill_each_step"] == "fresh":

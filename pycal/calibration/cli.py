@@ -56,7 +56,9 @@ def register(sub):
     s.add_argument("--start-density", type=float, default=None,
                    help="start particle density (default: the material config's value)")
     s.add_argument("--workers", type=int, default=None, help="parallel YADE processes (default: cores)")
-    s.add_argument("--timeout-s", type=float, default=3600.0, help="timeout per job in seconds")
+    s.add_argument("--cpu-limit-s", "--timeout-s", dest="timeout_s", type=float, default=3600.0,
+                   help="CPU-time limit per job in seconds (a starved run on a loaded machine is not stopped; "
+                        "one that used no CPU for 10x this long is); --timeout-s is the old name")
     s.add_argument("--runs", default=None, help="runs directory for the job cache (default runs/)")
     s.add_argument("--out", default=None, help="output folder (default runs/density/)")
     s.set_defaults(func=_cmd_fit_density)

@@ -20,15 +20,12 @@ compares responses with the lab, with the seed spread:
 
 A scalar comparison is inside when |sim mean - lab| <= band (its z = (sim - lab) / band);
 a curve comparison is inside when its RMS band z is <= 1 (pycal.post.compression). A
-prediction that misses (any comparison outside) gets a sensitivity run when it asks for
-one (`sensitivity: true`, settings in the section): each calibrated parameter of the
-material(s), and each key of its `sensitivity_extra` list (start values no stage fits, e.g.
-M3-wet.interactions.M3-wet.cohesion.force_fraction), moved by +relative_step, the change
-of the first missed response per parameter, largest first ("what drives it").
-The change is paired by seed: each moved run is compared with the prediction's run on the
-same seed (seeds 1..seeds_count of the prediction), which cancels the part of the seed
-noise that a seed carries whatever the parameter; its standard error is the SD of the
-per-seed changes / sqrt(n) (a curve comparison: each seed's mean RMS band z).
+prediction that misses and asks for a sensitivity (`sensitivity: true`, settings in the
+section) names the command that finds what drives the miss (`./run.sh pycal sensitivity
+NAME`, pycal.calibration.sensitivity: a screening design over every calibrated value and
+the `sensitivity_extra` keys); the main job does not run it.
+paired_change: the change of a response from base runs to moved runs, paired by seed (a
+curve comparison: each seed's mean RMS band z), used by the one-at-a-time design.
 Outputs: <study>/validation.csv, validation.json, plots/validation-<name>.png.
 """
 import json
@@ -160,9 +157,10 @@ def run(study):
                "plot": plot(study, pred["name"], comps)}
         missed = [c for c, cmp in zip(comps, pred["compare"]) if not c["inside"]]
         if missed and pred.get("sensitivity"):
-            base_by_seed = dict(zip(row["seeds"], results))
-            row["sensitivity"] = sensitivity(study, pred, extra, section["sensitivity"], base_by_seed,
-                                             pred["compare"][comps.index(missed[0])])
+            # what drives the miss is its own command (pycal.calibration.sensitivity): not in the main job
+            row["sensitivity_command"] = (f"./run.sh pycal sensitivity {pred['name']} --response "
+                                          f"{pred['compare'][comps.index(missed[0])]['response']}")
+            study.log(f"  what drives the miss: {row['sensitivity_command']}")
         for c in comps:
             sim = (f"{c['sim_mean']:.4g} +/- {c['sim_sd']:.2g} (n={c['n']})" if c["n"]
                    else "no value on any seed")
@@ -171,35 +169,6 @@ def run(study):
         rows.append(row)
         write(study, rows)
     return rows
-
-
-def sensitivity(study, pred, extra, cfg, base_by_seed, cmp):
-    """Change of the first missed response when each calibrated parameter of the
-    prediction's material(s) moves by +relative_step_fraction (one run set per parameter),
-    paired by seed with the prediction's runs (base_by_seed: {seed: result})."""
-    step = cfg["relative_step_fraction"]
-    seeds = study.seeds_from_base(cfg.get("seeds_count", 3))
-    values = [(k, v) for k, v in extra.items() if not k.startswith("rig.") and movable(v)]
-    if pred.get("sensitivity_extra"):            # start values no stage fits, read from the job
-        job = resolve_job(pred["rig"], pred["material"], extra)
-        values += [(k, override_value(job, k)) for k in pred["sensitivity_extra"]]
-    out = []
-    for key, value in values:
-        moved = dict(extra, **{key: value * (1 + step)})
-        row = {"parameter": key, "value": value, "moved_to": value * (1 + step), "change": None,
-               "change_se": None, "seeds": [], "error": None}
-        try:
-            res = study._run_seeds(pred["rig"], pred["material"], moved, seeds)
-        except RunError as exc:
-            out.append(dict(row, error=str(exc)))
-            continue
-        row.update(paired_change(dict(zip(study.last_seeds, res)), base_by_seed, cmp))
-        out.append(row)
-        se = f" +- {row['change_se']:.2g}" if row["change_se"] is not None else ""
-        study.log(f"  sensitivity {key} x{1 + step:g}: {cmp['response']} {row['change']:+.3g}{se} "
-                  f"(paired on seeds {row['seeds']})")
-    out.sort(key=lambda r: -abs(r["change"]) if r["change"] is not None and not math.isnan(r["change"]) else 0)
-    return out
 
 
 def paired_change(moved_by_seed, base_by_seed, cmp):

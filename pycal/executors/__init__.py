@@ -41,7 +41,7 @@ def make_executor(name="local", scheduler=None, **kw):
 
 
 def add_executor_args(s, default_workers="cores"):
-    """--executor, --scheduler, --workers, --timeout-s (pycal run and pycal calibrate)."""
+    """--executor, --scheduler, --workers, --cpu-limit-s (pycal run and pycal calibrate)."""
     s.add_argument("--executor", default="local", choices=EXECUTOR_NAMES,
                    help="where the YADE runs go: local processes (default), yade-batch tables, or a Dask "
                         "cluster (docs/cluster.md)")
@@ -51,7 +51,9 @@ def add_executor_args(s, default_workers="cores"):
     s.add_argument("--workers", type=int, default=None,
                    help=f"parallel YADE processes (default: {default_workers}); with --scheduler the "
                         f"cluster's workers decide")
-    s.add_argument("--timeout-s", type=float, default=3600.0, help="timeout per job in seconds")
+    s.add_argument("--cpu-limit-s", "--timeout-s", dest="timeout_s", type=float, default=3600.0,
+                   help="CPU-time limit per job in seconds (a starved run on a loaded machine is not stopped; "
+                        "one that used no CPU for 10x this long is); --timeout-s is the old name")
     s.add_argument("--replicas", type=int, default=None, metavar="N",
                    help="seeds per YADE process (a batch job, pycal.replicas); 1 turns replicas off. Default: "
                         "the seeds spread over the workers, for the rigs that have replicas")

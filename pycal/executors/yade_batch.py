@@ -32,7 +32,8 @@ from ..rig_contract import JOB_FILE, LOG_FILE
 from .base import Executor, say
 from .jobdirs import (cached_failure, cached_result, create_job_folder, finish, log_tail, prepare_temp,
                       temp_suffix)
-from .yade_process import die_with_parent, yade_env, yade_executable
+from .yade_process import (CPU_LIMIT_EXIT_CODES, WALL_LIMIT_FACTOR, cpu_limit_message, cpu_limited,
+                           die_with_parent, yade_env, yade_executable)
 
 # yade-batch cuts log paths longer than this (and then cannot write the log)
 MAX_LOG_PATH_CHARS = 230
@@ -139,11 +140,13 @@ class YadeBatch(Executor):
             yield from self._run_group(todo, rig, script, ks)
 
     def _executable(self):
-        """yade under a per-line timeout; both it and YADE die if their parent dies."""
+        """yade under a per-line CPU limit (and a wall limit WALL_LIMIT_FACTOR x that for a hung
+        line); both it and YADE die if their parent dies."""
         exe = shutil.which(yade_executable())
         if exe is None:
             raise RunError(f"'{yade_executable()}' not found: install YADE (./run.sh installs it)")
-        parts = ["timeout", "--foreground", "--signal=KILL", f"{self.timeout_s:g}", exe]
+        parts = (["timeout", "--foreground", "--signal=KILL", f"{WALL_LIMIT_FACTOR * self.timeout_s:g}"]
+                 + cpu_limited([exe], self.timeout_s))
         setpriv = shutil.which("setpriv")
         if setpriv:
             parts = [setpriv, "--pdeathsig", "KILL", "--"] + parts[:-1] + [setpriv, "--pdeathsig", "KILL", "--", exe]
@@ -162,7 +165,7 @@ class YadeBatch(Executor):
         cmd = batch_command(table, SCRIPT_DIR / script, self.workers, log_format, executable)
         env = dict(yade_env(), PYTHONUNBUFFERED="1")
         waves = math.ceil(len(ks) / self.workers)
-        patience_s = self.timeout_s * waves + self.patience_margin_s     # no line outlives its timeout
+        patience_s = WALL_LIMIT_FACTOR * self.timeout_s * waves + self.patience_margin_s   # no line outlives its wall limit
         output, lines = [], queue.Queue()
         try:
             proc = subprocess.Popen(die_with_parent(cmd), cwd=runs / rig, env=env, stdin=subprocess.DEVNULL,
@@ -218,8 +221,10 @@ class YadeBatch(Executor):
     def _complete(self, tmp, final, status, elapsed):
         """Complete one line from its wait status (as os.system gives it)."""
         code = status >> 8 if status > 0 else status
-        if code == _KILLED_BY_TIMEOUT and elapsed >= self.timeout_s - 2:
-            tail = f"timeout after {self.timeout_s:g} s"
+        if code == _KILLED_BY_TIMEOUT and elapsed >= WALL_LIMIT_FACTOR * self.timeout_s - 2:
+            tail = f"no result after {WALL_LIMIT_FACTOR * self.timeout_s:g} s of wall time (hung?)"
+        elif code in CPU_LIMIT_EXIT_CODES[:2]:
+            tail = cpu_limit_message(self.timeout_s)
         elif code:
             tail = f"exit code {code}: {log_tail(tmp / LOG_FILE)}"
         else:

@@ -1,6 +1,8 @@
 """One YADE process for one job: `yade -j1 -x -n yade_scripts/<rig>.py job.json`."""
+import math
 import os
 import shutil
+import signal
 import subprocess
 from pathlib import Path
 
@@ -36,8 +38,31 @@ def die_with_parent(cmd):
     return [setpriv, "--pdeathsig", "KILL", "--"] + list(cmd) if setpriv else list(cmd)
 
 
+# A job's limit is in CPU seconds (RLIMIT_CPU through util-linux's prlimit): a run starved
+# of its core on an overloaded machine is slow, not broken. The wall clock only stops a
+# run that has not used its CPU time in this many times its limit (a hung process).
+WALL_LIMIT_FACTOR = 10.0
+CPU_LIMIT_EXIT_CODES = (-signal.SIGXCPU, 128 + signal.SIGXCPU, -signal.SIGKILL)   # as Popen / a shell see them
+
+
+def cpu_limited(cmd, cpu_limit_s):
+    """cmd under a CPU-time limit of cpu_limit_s (s): SIGXCPU at the limit, SIGKILL 5 s of
+    CPU later; unchanged where prlimit is missing (the wall limit still holds)."""
+    prlimit = shutil.which("prlimit")
+    if prlimit is None:
+        return list(cmd)
+    soft = max(1, math.ceil(cpu_limit_s))
+    return [prlimit, f"--cpu={soft}:{soft + 5}"] + list(cmd)
+
+
+def cpu_limit_message(cpu_limit_s):
+    return (f"CPU time limit of {cpu_limit_s:g} s reached (--cpu-limit-s; the run itself is not known to "
+            "be broken: a stiffer material or a longer procedure needs more)")
+
+
 def run_job(job, runs_dir=DEFAULT_RUNS_DIR, timeout_s=3600):
-    """Run one job (or return its cached result). Raises RunError on failure."""
+    """Run one job (or return its cached result). timeout_s: its CPU-time limit (s; the
+    wall clock allows WALL_LIMIT_FACTOR x that). Raises RunError on failure."""
     runs_dir = Path(runs_dir).resolve()     # YADE runs in the job's folder: a relative path would not hold there
     cached = cached_result(job, runs_dir)
     if cached is not None:
@@ -54,14 +79,20 @@ def run_job(job, runs_dir=DEFAULT_RUNS_DIR, timeout_s=3600):
     tmp, final = prepare_temp(job, runs_dir)
     with open(tmp / LOG_FILE, "w") as log:
         try:
-            proc = subprocess.run(die_with_parent(yade_command(script, tmp / JOB_FILE)), cwd=tmp, env=yade_env(),
-                                  stdout=log, stderr=subprocess.STDOUT, stdin=subprocess.DEVNULL,
-                                  timeout=timeout_s)
+            proc = subprocess.run(die_with_parent(cpu_limited(yade_command(script, tmp / JOB_FILE), timeout_s)),
+                                  cwd=tmp, env=yade_env(), stdout=log, stderr=subprocess.STDOUT,
+                                  stdin=subprocess.DEVNULL, timeout=WALL_LIMIT_FACTOR * timeout_s)
             rc = proc.returncode
         except subprocess.TimeoutExpired:
             rc = "timeout"
     if rc != 0:
         (tmp / RESULT_FILE).unlink(missing_ok=True)
-        tail = f"timeout after {timeout_s:g} s" if rc == "timeout" else f"exit code {rc}: {log_tail(tmp / LOG_FILE)}"
+        if rc == "timeout":
+            tail = (f"no result after {WALL_LIMIT_FACTOR * timeout_s:g} s of wall time ({WALL_LIMIT_FACTOR:g} x "
+                    f"the CPU limit): the process hung or the machine is far overloaded")
+        elif rc in CPU_LIMIT_EXIT_CODES[:2]:
+            tail = cpu_limit_message(timeout_s)
+        else:
+            tail = f"exit code {rc}: {log_tail(tmp / LOG_FILE)}"
         return finish(tmp, final, tail)
     return finish(tmp, final, log_tail(tmp / LOG_FILE))

@@ -95,7 +95,10 @@ def job_folder():
 
 
 def provenance():
-    """YADE version, git commit, threads, host and times of this run."""
+    """YADE version, git commit, threads, host and times of this run: wall and CPU time
+    (s) of the process, and CPU time and time steps per phase (demlib.phase_clock;
+    steps_count is O.iter of the last scene, a fresh-fill rig's earlier scenes are in the
+    phases)."""
     try:
         import yade.config
         yade_version = yade.config.version
@@ -104,8 +107,10 @@ def provenance():
     try:
         from yade import O
         threads, simulated_time, steps = O.numThreads, O.time, O.iter
-    except Exception:
-        threads = simulated_time = steps = None
+        from .phase_clock import CLOCK
+        phases = CLOCK.report()
+    except ImportError:                 # outside YADE (unit tests of the writers)
+        threads = simulated_time = steps = phases = None
     from pycal.gitinfo import git_commit, git_dirty
     commit, dirty = git_commit(), git_dirty()
     return {
@@ -118,6 +123,8 @@ def provenance():
         "started_utc": _STARTED,
         "finished_utc": datetime.datetime.now(datetime.timezone.utc).isoformat(timespec="seconds"),
         "wall_time_s": round(time.time() - _T0, 3),
+        "cpu_time_s": round(time.process_time(), 3),
+        "phase_cpu": phases,
         "simulated_time_s": simulated_time,
         "steps_count": steps,
     }

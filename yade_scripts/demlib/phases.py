@@ -34,8 +34,7 @@ def steps_of(seconds, dt):
 def drive(procedure):
     """Run one procedure alone (the scene has no other): step YADE as it asks, run its
     barriers at once. Returns the procedure's return value."""
-    from yade import O
-    step = O.step
+    from .phase_clock import CLOCK
     value = None
     try:
         while True:
@@ -43,8 +42,7 @@ def drive(procedure):
             if isinstance(request, Barrier):
                 value = request.action()
             else:
-                for _ in range(int(request)):
-                    step()
+                CLOCK.steps(request)
                 value = None
     except StopIteration as stop:
         return stop.value

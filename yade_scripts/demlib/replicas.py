@@ -29,6 +29,7 @@ from yade import O
 from pycal.rig_contract import BATCH_SEEDS_KEY, LAYOUT_KEY, replica_dir_name, seed_job
 
 from .jobio import RigFailure
+from .phase_clock import CLOCK
 from .phases import Barrier
 from .scene import Scene, World
 
@@ -128,7 +129,6 @@ class Driver:
     def run(self):
         for k in range(len(self.procs)):
             self._resume(k, None)
-        step = O.step
         while self.waiting:
             barriers = {k: r for k, r in self.waiting.items() if isinstance(r, Barrier)}
             if len(barriers) == len(self.waiting):
@@ -144,8 +144,7 @@ class Driver:
                     self._resume(k, value)
                 continue
             n = min(r for r in self.waiting.values() if not isinstance(r, Barrier))
-            for _ in range(n):
-                step()
+            CLOCK.steps(n)
             for k in sorted(self.waiting):
                 r = self.waiting[k]
                 if isinstance(r, Barrier):

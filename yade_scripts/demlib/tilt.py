@@ -15,6 +15,7 @@ import os
 from yade import O
 
 from .jobio import RigFailure
+from .phase_clock import CLOCK
 from .phases import drive
 from .tilt_bodies import Lid, add_rigid_cell, force_sum
 from .tilt_test import Tilt, tilt_test
@@ -54,13 +55,15 @@ def pour_and_strike(scene, diameter, z_bottom, cell_top, pour_height, porosity, 
         funnel = list(scene.add_cylinder(diameter, funnel_h, funnel_segments, funnel_material, z0=cell_top))
     scene.pour_cloud(diameter, z_bottom, pour_height, porosity)
     scene.set_timestep()
-    t1 = drive(scene.settle("pour"))
+    with CLOCK.phase("pour"):
+        t1 = drive(scene.settle("pour"))
     print(f"poured: {len(scene.live_spheres())} particles settled in {t1:.2f} s", flush=True)
     above = [b.id for b in scene.live_spheres() if b.state.pos[2] > strike_level]
     scene.remove_spheres(above)
     for i in funnel:
         O.bodies.erase(i)
-    t2 = drive(scene.settle("strike"))
+    with CLOCK.phase("strike"):
+        t2 = drive(scene.settle("strike"))
     return t1 + t2
 
 
@@ -168,8 +171,9 @@ def run_friction_rig(job, build, out_dir):
     from .scene import Scene
 
     def make_scene():
-        scene = Scene(job)
-        return scene, build(scene)
+        with CLOCK.phase("build_and_fill"):
+            scene = Scene(job)
+            return scene, build(scene)
 
     scene, parts = make_scene()
     g, p = scene.rig["geometry"], scene.rig["procedure"]
@@ -195,8 +199,9 @@ def run_friction_rig(job, build, out_dir):
                 lid, tilt = _start(scene, p, d)
             if k and not fresh:
                 _check_contents(scene, lid, parts, steps, k)
-            cons = consolidate(scene, lid, parts["cell"], parts["plate_ids"], stress, area, p, curve, k,
-                               parts["floor_z_m"], parts["cell_bottom_z_m"])
+            with CLOCK.phase("consolidate"):
+                cons = consolidate(scene, lid, parts["cell"], parts["plate_ids"], stress, area, p, curve, k,
+                                   parts["floor_z_m"], parts["cell_bottom_z_m"])
             res = tilt_test(scene, tilt, parts["cell"], lid, parts["plate_ids"], parts["spill_box_m"], p, record, k,
                             restore=not fresh)
             res.update(cons)
@@ -232,7 +237,8 @@ def run_friction_rig(job, build, out_dir):
     # error here is a bug: the run fails (exit 4, not kept as a verdict), nothing is hidden
     from pycal.post import friction as post
     res = dict(out, rig=scene.job["rig"], material=scene.job["material"], seed=scene.job["seed"], job=scene.job)
-    done = post.write_outputs([res], out_dir)
+    with CLOCK.phase("outputs"):
+        done = post.write_outputs([res], out_dir)
     out["misfits"] = done["misfits"]
     out["output_files"] = [os.path.basename(f) for f in done["files"]]
     return out

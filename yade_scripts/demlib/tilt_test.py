@@ -11,10 +11,12 @@ tilt_test() runs the phases in order:
 2. static friction: tilt (at pre_tilt_rate_deg_s until the cell has slid
    pre_tilt_slide_fraction of the onset distance, then at the lab's tilt_rate_deg_s)
    until the cell has slid slide_onset_displacement_m (mu_static = tan of that angle);
-3. dynamic friction: hold that angle and time the travel of dynamic_travel_distance_m
-   (fit of x = v0 t + a t^2 / 2, mu_dynamic = tan t - a / (g cos t)); a stalled cell makes
-   the tilt resume (at tilt_restart_rate_deg_s) to the next onset, where the hold is
-   repeated (dynamic_restarts_count);
+3. dynamic friction (procedure.measure_dynamic_friction: true): hold that angle and time
+   the travel of dynamic_travel_distance_m (fit of x = v0 t + a t^2 / 2, mu_dynamic =
+   tan t - a / (g cos t)); a stalled cell makes the tilt resume (at
+   tilt_restart_rate_deg_s) to the next onset, where the hold is repeated
+   (dynamic_restarts_count). false: the step ends at the onset (mu_dynamic null, sticks
+   only when there was no onset up to max_tilt_deg);
 4. stop the cell, tilt back and settle (not when the scene is discarded after the step).
 """
 import math
@@ -23,6 +25,7 @@ from yade import O
 from yade import Vector3
 
 from .jobio import RigFailure
+from .phase_clock import CLOCK
 from .phases import drive
 from .tilt_bodies import force_sum, join, set_damped, split, stop_all
 from pycal.post.friction import DYNAMIC_MAX_ANGLE_DEG  # pure Python: one rule for rig and post
@@ -108,7 +111,8 @@ def free_the_cell(scene, cell, lid, proc, step_index):
     # freed at zero tilt, the cell can drift while the unloaded contents relax (wet fines
     # after 60 kPa: 4.3 mm before 0.5 deg of tilt, measured); that is not sliding
     x_free, y_free = cell.pos[0], cell.pos[1]
-    drive(scene.settle(f"cell freed before the tilt of step {step_index}"))
+    with CLOCK.phase("settle_before_tilt"):
+        drive(scene.settle(f"cell freed before the tilt of step {step_index}"))
     return math.hypot(cell.pos[0] - x_free, cell.pos[1] - y_free)
 
 
@@ -255,11 +259,19 @@ def tilt_test(scene, tilt, cell, lid, plate_ids, spill_box, proc, record, step_i
     if mode == "undamped":
         set_damped(scene.sphere_ids, False)
     run = TiltRecorder(scene, tilt, cell, plate_ids, spill_box, record, step_index, proc["record_interval_s"])
-    out, angle = static_onset(run, proc)
-    if out["onset_angle_deg"] is not None:
+    with CLOCK.phase("tilt_static"):
+        out, angle = static_onset(run, proc)
+    if out["onset_angle_deg"] is not None and not proc["measure_dynamic_friction"]:
+        # static friction only (a calibration stage that reads mu_static): the step ends at
+        # the onset; everything up to it is the same computation as with the hold
+        out.update({"mu_dynamic": None, "dynamic_angle_deg": None, "dynamic_travel_time_s": None,
+                    "dynamic_restarts_count": 0, "plate_force_ratio_sliding": None})
+        sticks = False
+    elif out["onset_angle_deg"] is not None:
         if mode == "undamped_when_sliding":
             set_damped(scene.sphere_ids, False)
-        out.update(dynamic_travel(run, proc, angle))
+        with CLOCK.phase("tilt_dynamic"):
+            out.update(dynamic_travel(run, proc, angle))
         sticks = out["dynamic_travel_time_s"] is None
     else:
         out.update({"mu_dynamic": None, "dynamic_angle_deg": None, "dynamic_travel_time_s": None,
@@ -277,7 +289,8 @@ def tilt_test(scene, tilt, cell, lid, plate_ids, spill_box, proc, record, step_i
         "drift_before_tilt_m": drift,
     })
     if restore:
-        tilt_back(run, scene, cell, lid, proc)
+        with CLOCK.phase("tilt_back"):
+            tilt_back(run, scene, cell, lid, proc)
     out["spilled_particles_count"] = run.spilled
     return out
 
