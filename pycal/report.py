@@ -136,6 +136,27 @@ def _validation(study_dir, rows):
     return parts
 
 
+def _run_at_checks(rows):
+    """Stages that ran at other material values (run_at), checked at the calibrated ones."""
+    if not rows:
+        return []
+    parts = ["<h2>Stages run at other values, checked with the calibrated set</h2>",
+             "<p>These stages ran at the values in <code>run_at</code> (a cheaper stiffness the response was "
+             "measured not to depend on); here their response with the final calibrated set at the calibrated "
+             "values, beside the stage's model at its estimate and the target.</p>",
+             "<table><tr><th>material / stage</th><th>response</th><th>ran at</th><th>checked at</th>"
+             "<th>check: mean +- SD (n)</th><th>stage model at the estimate</th><th>target +- band</th></tr>"]
+    for r in rows:
+        fmt = lambda d: ", ".join(f"{k.split('.')[-1]} {_num(v)}" for k, v in d.items())   # noqa: E731
+        check = f"{_num(r['value_mean'])} +- {_num(r['value_sd'])} ({r['n']})" if r["n"] else \
+            f"no value ({_esc(r.get('error') or '')})"
+        parts.append(f"<tr><td>{_esc(r['material'])} / {_esc(r['stage'])}</td><td>{_esc(r['response'])}</td>"
+                     f"<td>{_esc(fmt(r['run_at']))}</td><td>{_esc(fmt(r['calibrated_at']))}</td>"
+                     f"<td class=num>{check}</td><td class=num>{_num(r['stage_at_estimate'])}</td>"
+                     f"<td class=num>{_num(r['target'])} +- {_num(r['band'])}</td></tr>")
+    return parts + ["</table>"]
+
+
 def _application(study_dir, rows):
     """The 'application' section: design runs with the calibrated values (no lab test)."""
     if not rows:
@@ -184,6 +205,7 @@ def write_report(study_dir):
                      f"<td class=num>{c['runs_simulated']}</td><td class=num>{c['elapsed_s']:.0f}</td></tr>")
     parts.append("</table><h2>Stages</h2>")
     parts += [_stage_detail(study_dir, s) for s in stages if s["kind"] != "inherit"]
+    parts += _run_at_checks(summary.get("run_at_checks") or [])
     parts += _validation(study_dir, summary.get("predicted") or [])
     parts += _application(study_dir, summary.get("applied") or [])
     parts.append("<h2>Calibrated material files</h2>")
@@ -232,6 +254,6 @@ def _sensitivity_section(study_dir, r):
                 parts.append(_img(study_dir, str(plot)))
             return parts
     if r.get("sensitivity_command"):
-        return [f"<p>{_esc(r['prediction'])} missed; what drives it: <code>{_esc(r['sensitivity_command'])}"
+        return [f"<p>{_esc(r['prediction'])} missed; what drives the miss: <code>{_esc(r['sensitivity_command'])}"
                 f"</code> (not part of the main job)</p>"]
     return []

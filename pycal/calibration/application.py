@@ -67,6 +67,7 @@ def run(study):
     rows = []
     for spec in section["runs"]:
         study.log(f"[application] {spec['name']}: {spec['rig']} on {spec['material']} with the calibrated values")
+        study.section = f"application/{spec['name']}"
         extra = run_overrides(study.overrides, spec)
         row = {"name": spec["name"], "rig": spec["rig"], "material": spec["material"], "responses": [],
                "seeds": [], "error": None, "plot": None}

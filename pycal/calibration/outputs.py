@@ -6,6 +6,9 @@
                 target, the seed noise (parameter_unit / response_unit columns give the units)
   history.csv   one row per point run: parameters, response mean, std and runs
   runs.csv      one row per run: parameters, seed, response value
+  jobs.csv      one row per job asked: section (material/stage, validation/..., application/...),
+                rig, seed, job id, status, batch job id (a seed run in a batch: the batch's folder
+                holds the result.json and its provenance)
   summary.json  all of the above plus the study config, seeds, YADE versions of the runs
 """
 import json
@@ -24,6 +27,7 @@ STAGE_COLUMNS = ["material", "stage", "kind", "parameter", "parameter_unit", "ke
                  "response_at_estimate", "seed_noise_sd", "message"]
 POINT_COLUMNS = ["material", "stage", "rig", "parameters", "response", "mean", "std", "n", "seeds"]
 RUN_COLUMNS = ["material", "stage", "rig", "parameters", "seed", "response", "value"]
+JOB_COLUMNS = ["section", "material", "rig", "seed", "job_id", "status", "batch_job_id"]
 
 
 def _cell(v):
@@ -69,6 +73,7 @@ def write_all(study):
     write_csv(out / "history.csv", POINT_COLUMNS,
                      [[_cell(p[c]) for c in POINT_COLUMNS] for p in study.points])
     write_csv(out / "runs.csv", RUN_COLUMNS, [[_cell(r[c]) for c in RUN_COLUMNS] for r in study.runs])
+    write_csv(out / "jobs.csv", JOB_COLUMNS, [[j[c] for c in JOB_COLUMNS] for j in getattr(study, "jobs", [])])
     summary = {"study": study.cfg["raw"], "config_file": str(study.config_path), "seeds": study.seeds,
                "seed_base": study.seed_base,
                # what the calibration fitted ("calibrated on") and what it predicts with those values
@@ -76,6 +81,7 @@ def write_all(study):
                                   "responses": [x.get("response") for x in r.get("responses", [])]}
                                  for r in study.stage_rows if r["kind"] != "inherit"],
                "predicted": getattr(study, "validation_rows", []),
+               "run_at_checks": getattr(study, "run_at_check_rows", []),
                "applied": getattr(study, "application_rows", []),
                "stages": study.stage_rows, "history": study.points,
                "runs": study.runs, "overrides": study.overrides, "intervals": study.intervals,

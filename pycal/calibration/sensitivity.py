@@ -147,6 +147,7 @@ def run(study, name, design="screening", seeds_per_run=1, response=None):
     step = (section.get("sensitivity") or {}).get("relative_step_fraction", 0.2)
     extra = run_overrides(study.overrides, pred)
     facs = factors(study, pred, extra)
+    study.section = f"sensitivity/{name}"
     if not facs:
         raise ConfigError(str(study.config_path), f"validation.predictions.{name}",
                           "no calibrated value to move (run ./run.sh calibrate first)")

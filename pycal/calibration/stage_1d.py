@@ -61,7 +61,7 @@ def run(study, material, st):
         return min(st["max_runs_count"] - (study.runs_requested - runs_at_start), study.runs_left())
 
     def extra(x):
-        return {**st["rig_overrides"], **{k: x for k in p["keys"]}}
+        return {**st["rig_overrides"], **st["run_at"], **{k: x for k in p["keys"]}}
 
     jr = study.stage_journal(material, st)
 

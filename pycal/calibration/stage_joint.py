@@ -52,7 +52,7 @@ def run(study, material, st):
         return min(st["max_runs_count"] - (study.runs_requested - runs_at_start), study.runs_left())
 
     def extra(xs, r):
-        e = dict(r["rig_overrides"])
+        e = dict(r["rig_overrides"], **st["run_at"])
         for p, x in zip(params, xs):
             e.update({k: x for k in p["keys"]})
         return e

@@ -54,6 +54,7 @@ class Study:
         self.intervals = {m: {} for m in self.cfg["materials"]}   # key -> (estimate, low, high) found so far
         self.stage_rows, self.points, self.runs = [], [], []
         self.validation_rows = []    # predictions of tests the calibration never saw (validation.py)
+        self.run_at_check_rows = []  # stages that ran at other material values, at the calibrated ones
         self.application_rows = []   # design runs with the calibrated values (application.py)
         self.runs_requested = 0
         self.yade_versions = set()
@@ -64,6 +65,8 @@ class Study:
         # stage's runs, which the response model takes as independent
         self._stage_seeds = {}
         self.last_seeds = []         # seeds actually run by the last _run_seeds (replacements included)
+        self.section = "study"       # what the runs are for now: '<material>/<stage>', 'validation/<name>' ...
+        self.jobs = []               # every job asked: section, rig, seed, job id, status (outputs: jobs.csv)
         self.t0 = time.time()
         self.journal = Journal(self.out / "journal.json")
         # every target now: a broken lab file stops the study before any run
@@ -100,6 +103,10 @@ class Study:
             attempted += len(jobs)
             out = self.executor.run(jobs, raise_on_error=False)
             errors = list(getattr(self.executor, "last_errors", []))
+            self.jobs += [{"section": self.section, "material": material, "rig": rig, "seed": j["seed"],
+                           "job_id": j["job_id"], "status": "ok" if r is not None else "failed",
+                           "batch_job_id": ((r or {}).get("provenance") or {}).get("batch_job_id", "")}
+                          for j, r in zip(jobs, out)]
             slots = [s for s in wanted if s not in results]
             retry = []
             for slot, seed, r in zip(slots, batch, out):
@@ -278,6 +285,7 @@ class Study:
                 t_stage, runs_before = time.time(), self.runs_requested
                 simulated_before = getattr(self.executor, "simulated_count", 0)
                 rig = st.get("rig") or ", ".join(r["rig"] for r in st.get("responses", []))
+                self.section = f"{material}/{st['label']}"
                 self.log(f"[stage {k}/{n_stages}] {material}: {st['label']}" + (f" on {rig}" if rig else ""))
                 if st["kind"] == "inherit":
                     row = self.stage_inherit(material, st)
@@ -303,6 +311,10 @@ class Study:
                 if not row["parameters"]:
                     self.log(f"  -> not met: {row['message']}")
                 outputs.write_all(self)
+        from . import run_at_check
+        self.section = "run_at_check"
+        run_at_check.run(self)                           # stages that ran at other values, at the calibrated ones
+        outputs.write_all(self)
         from . import validation
         self.validation_rows = validation.run(self)      # predictions with the calibrated values
         outputs.write_all(self)

@@ -19,6 +19,9 @@ A parameter group:
               tolerance_coefficient, tolerance_pa, tolerance_kg_m3, tolerance_fraction)
   response_increases         1-D stages: the direction physics gives the response (required)
   response_slope_estimate    1-D stages, optional: |d response / d parameter| from physics
+A stage's run_at (optional): material keys and the values the stage's runs use instead of
+the study's current ones, not carried into the calibrated set (e.g. the friction stages
+at a cheaper Young's modulus the friction responses are measured not to depend on).
 A target: {value: X} | {sample: KEY, test: angle_of_repose} | {} (bulk density: the
 material's lab sample), with optional band_<unit> (the lab band: plotted, and the
 parameter range it allows) and standard_error_<unit> (the target is itself a mean,
@@ -188,13 +191,21 @@ def _check_overrides(c, st, key, material=None, mat_cfg=None):
     for k in st.get("rig_overrides", {}) or {}:
         if not str(k).startswith("rig."):
             c.fail(f"{key}.rig_overrides.{k}", "only rig keys (rig.procedure...) may be overridden here")
+    run_at = st.get("run_at", {}) or {}
+    if not isinstance(run_at, dict):
+        c.fail(f"{key}.run_at", "must be a mapping of material keys to the values this stage runs at")
+    for k, v in run_at.items():
+        if str(k).startswith("rig."):
+            c.fail(f"{key}.run_at.{k}", "only material keys here (rig keys: rig_overrides)")
+        if mat_cfg is not None and not _material_has(mat_cfg, k):
+            c.fail(f"{key}.run_at.{k}", f"no such key in configs/materials/{material}.yaml")
 
 
 def _one_d(c, st, key, material, mat_cfg, seeds):
     kind = st["stage"]
     _check_removed(c, st, key)
     c.keys(st, key, ["stage", "rig", "parameter"] + ([] if kind == "density" else ["response"]),
-           ["name", "response", "target", "rig_overrides", "set", "max_runs_count", "lab_dir"])
+           ["name", "response", "target", "rig_overrides", "run_at", "set", "max_runs_count", "lab_dir"])
     _check_overrides(c, st, key, material, mat_cfg)
     response = _response(c, st.get("response", "bulk_density_kg_m3"), f"{key}.response")
     if response.vector:
@@ -202,7 +213,7 @@ def _one_d(c, st, key, material, mat_cfg, seeds):
     out = {"kind": kind, "label": stage_label(st), "rig": st["rig"], "response": response.name,
            "target": _target(c, st.get("target"), f"{key}.target", response),
            "rig_overrides": dict(st.get("rig_overrides") or {}), "set": dict(st.get("set") or {}),
-           "lab_dir": st.get("lab_dir"),
+           "run_at": dict(st.get("run_at") or {}), "lab_dir": st.get("lab_dir"),
            "parameter": _parameter(c, st["parameter"], f"{key}.parameter", material, mat_cfg, kind, True)}
     out["max_runs_count"] = int(c.number(st.get("max_runs_count", DEFAULT_POINTS_COUNT * seeds),
                                          f"{key}.max_runs_count", 2 * seeds))
@@ -211,7 +222,7 @@ def _one_d(c, st, key, material, mat_cfg, seeds):
 
 def _joint(c, st, key, material, mat_cfg, seeds):
     _check_removed(c, st, key)
-    c.keys(st, key, ["stage", "responses", "parameters"], ["name", "set", "max_runs_count", "lab_dir"])
+    c.keys(st, key, ["stage", "responses", "parameters"], ["name", "set", "run_at", "max_runs_count", "lab_dir"])
     _check_overrides(c, st, key, material, mat_cfg)
     if not isinstance(st["parameters"], list) or not 2 <= len(st["parameters"]) <= 3:
         c.fail(f"{key}.parameters", "a joint stage moves a list of 2 or 3 parameter groups")
@@ -230,7 +241,7 @@ def _joint(c, st, key, material, mat_cfg, seeds):
     params = [_parameter(c, p, f"{key}.parameters[{j}]", material, mat_cfg, "joint", False)
               for j, p in enumerate(st["parameters"])]
     out = {"kind": "joint", "label": stage_label(st), "responses": resp, "parameters": params,
-           "set": dict(st.get("set") or {}), "lab_dir": st.get("lab_dir")}
+           "set": dict(st.get("set") or {}), "run_at": dict(st.get("run_at") or {}), "lab_dir": st.get("lab_dir")}
     out["max_runs_count"] = int(c.number(st.get("max_runs_count", DEFAULT_POINTS_COUNT * seeds * len(resp)),
                                          f"{key}.max_runs_count", (len(params) + 1) * seeds * len(resp)))
     return out
@@ -254,7 +265,10 @@ def load_study(path):
     c = _Checker(path)
     _check_removed(c, data, "")
     c.keys(data, "", ["name", "materials", "seeds_count"], ["description", "max_runs_count", "design_case",
-                                                            "validation", "application"])
+                                                            "run_at_checks", "validation", "application"])
+    if "run_at_checks" in data:
+        c.keys(data["run_at_checks"], "run_at_checks", [], ["seeds_count"])
+        c.number(data["run_at_checks"].get("seeds_count", 1), "run_at_checks.seeds_count", 1)
     if "validation" in data:
         from . import validation
         validation.check(data["validation"], c)

@@ -144,16 +144,17 @@ def run(study):
     rows = []
     for pred in section["predictions"]:
         study.log(f"[validation] {pred['name']}: {pred['rig']} on {pred['material']} with the calibrated values")
+        study.section = f"validation/{pred['name']}"
         extra = run_overrides(study.overrides, pred)
         try:
             results = study._run_seeds(pred["rig"], pred["material"], extra, seeds)
         except RunError as exc:
             rows.append({"prediction": pred["name"], "rig": pred["rig"], "material": pred["material"],
-                         "comparisons": [], "error": str(exc), "sensitivity": []})
+                         "comparisons": [], "error": str(exc)})
             continue
         comps = [compare_results(results, cmp) for cmp in pred["compare"]]
         row = {"prediction": pred["name"], "rig": pred["rig"], "material": pred["material"], "comparisons": comps,
-               "seeds": list(study.last_seeds), "sensitivity": [], "error": None,
+               "seeds": list(study.last_seeds), "error": None,
                "plot": plot(study, pred["name"], comps)}
         missed = [c for c, cmp in zip(comps, pred["compare"]) if not c["inside"]]
         if missed and pred.get("sensitivity"):

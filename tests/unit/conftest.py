@@ -27,6 +27,8 @@ case "$FAKE_MODE" in
   refuse) echo "RIG FAILED: pile settle: no rest after 8 s" | tee rig_failure.txt; exit 3 ;;
   partial) echo '{"bulk' > result.json.part; exit 4 ;;
   sleep) sleep 5 ;;
+  sleep_then_ok) sleep 2; echo '{"bulk_density_kg_m3": 1600.0, "n_particles": 100}' > result.json ;;
+  spin) while :; do :; done ;;
 esac
 """
 

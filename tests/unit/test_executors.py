@@ -125,7 +125,7 @@ esac
 """
 
 
-@pytest.mark.parametrize("mode, why", [("silent", "yade-batch reported nothing for 2 s and was stopped"),
+@pytest.mark.parametrize("mode, why", [("silent", "yade-batch reported nothing for 11 s and was stopped"),
                                        ("dies", "yade-batch ended (exit code 1) without a status for this line")])
 def test_yade_batch_that_hangs_or_dies_is_reported_per_job(tmp_path, fake_yade, monkeypatch, mode, why):
     exe = tmp_path / "fake-yade-batch"

@@ -74,11 +74,26 @@ def test_half_written_result_is_not_a_result(tmp_path, fake_yade, monkeypatch):
     assert runner.cached_result(job, tmp_path / "runs") is None
 
 
-def test_timeout(tmp_path, fake_yade, monkeypatch):
+def test_cpu_limit_stops_a_run_that_uses_its_cpu_time(tmp_path, fake_yade, monkeypatch):
+    monkeypatch.setenv("FAKE_MODE", "spin")
+    job = resolve_job("fill", "M2", seed=1)
+    with pytest.raises(RunError, match="CPU time limit of 1 s reached"):
+        runner.run_job(job, tmp_path / "runs", timeout_s=1.0)
+
+
+def test_a_starved_run_is_not_stopped_by_its_cpu_limit(tmp_path, fake_yade, monkeypatch):
+    """2 s of wall time without CPU (as a run waiting for a core on an overloaded machine)
+    under a 1 s CPU limit completes."""
+    monkeypatch.setenv("FAKE_MODE", "sleep_then_ok")
+    job = resolve_job("fill", "M2", seed=1)
+    assert runner.run_job(job, tmp_path / "runs", timeout_s=1.0)["n_particles"] == 100
+
+
+def test_a_hung_run_is_stopped_by_the_wall_limit(tmp_path, fake_yade, monkeypatch):
     monkeypatch.setenv("FAKE_MODE", "sleep")
     job = resolve_job("fill", "M2", seed=1)
-    with pytest.raises(RunError, match="timeout"):
-        runner.run_job(job, tmp_path / "runs", timeout_s=0.5)
+    with pytest.raises(RunError, match="no result after 1 s of wall time"):
+        runner.run_job(job, tmp_path / "runs", timeout_s=0.1)
 
 
 def test_pool_runs_each_job_once(tmp_path, fake_yade):
