@@ -226,12 +226,13 @@ def test_yade_batch_reports_a_failed_line_with_its_log(tmp_path, reference):
     assert rig_line in (failed / "yade.log").read_text()
 
 
-def test_yade_batch_timeout_is_reported_per_job(tmp_path):
+def test_yade_batch_cpu_limit_is_reported_per_job(tmp_path):
+    """A fill (several s of CPU) under a 1 s CPU limit: stopped by its CPU limit."""
     ex = YadeBatch(tmp_path / "runs", workers=2, timeout_s=1.0, progress=False)
     t0 = time.time()
     assert ex.run(fill_jobs()[:1], raise_on_error=False) == [None]
     assert time.time() - t0 < 30
-    assert re.fullmatch(r"fill-M2-s1-\w+: no result \(timeout after 1 s\); log: .*\.failed/yade\.log",
+    assert re.fullmatch(r"fill-M2-s1-\w+: no result \(CPU time limit of 1 s reached .*\); log: .*\.failed/yade\.log",
                         ex.last_errors[0]), ex.last_errors[0]
 
 

@@ -263,3 +263,27 @@ def test_internal_friction_of_frictionless_spheres_is_low_and_rises_with_contact
     rough = internal(tmp_path_factory, "internal_start", {}, [3000, 3000])
     assert smooth["mu_static"][0] < SMOOTH_MAX
     assert rough["mu_static"][0] > smooth["mu_static"][0] + 0.15
+
+
+def test_static_only_reads_the_same_onset_and_skips_the_hold(tmp_path_factory):
+    """measure_dynamic_friction: false ends a step at the onset: the same mu_static to the
+    last bit (the hold comes after the reading), no dynamic value, fewer time steps."""
+    full = wall(tmp_path_factory, "mu0.3", 0.3, [3000])
+    o = dict(NO_ROLL, **{"interactions.steel.friction_coefficient": 0.3,
+                         "rig.procedure.consolidation_stresses_pa": [3000],
+                         "rig.procedure.measure_dynamic_friction": False})
+    static = run_job(resolve_job("wall_friction", "M2", o, seed=SEED),
+                     runs_dir=tmp_path_factory.mktemp("static"), timeout_s=900)
+    assert static["mu_static"] == full["mu_static"] and full["mu_dynamic"][0] is not None
+    assert static["mu_dynamic"] == [None] and static["sticks"] == [False]
+    assert static["steps"] < full["steps"]
+
+
+def test_the_phase_clock_accounts_for_every_time_step(tmp_path_factory):
+    """provenance.phase_cpu: the phases' time steps add up to YADE's own count (a stepping
+    loop that bypassed the clock would show here), and the tilt phases did step."""
+    r = wall(tmp_path_factory, "mu0.2", 0.2, CASES[0.2][0])
+    phases = r["provenance"]["phase_cpu"]
+    assert sum(p["steps_count"] for p in phases.values()) == r["steps"] == r["provenance"]["steps_count"]
+    for name in ("pour", "consolidate", "tilt_static", "tilt_dynamic", "tilt_back"):
+        assert phases[name]["steps_count"] > 0 and phases[name]["step_cpu_s"] > 0, name

@@ -80,7 +80,7 @@ def consolidate(scene, lid, cell, plate_ids, stress_pa, area, proc, curve, step_
         # the cell sank during the previous tilt (it hangs on the lid): the operator lifts
         # it back to its gap before the next load
         cell.lift_bottom_to(cell_bottom_z)
-        O.step()
+        CLOCK.steps(1)
     lid.make_kinematic()
     servo = ServoPlate(scene, lid.members, area, proc["plate_speed_max_m_s"], proc["servo_relaxation_time_s"],
                        proc["servo_control_interval_s"], floor_z=floor_z,
