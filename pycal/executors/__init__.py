@@ -33,6 +33,9 @@ def executor_class(name):
 def make_executor(name="local", scheduler=None, **kw):
     """An executor by name; `scheduler` (a Dask scheduler address) only for 'dask'."""
     cls = executor_class(name)
+    limit = kw.get("timeout_s")
+    if limit is not None and not limit > 0:
+        raise ConfigError("--cpu-limit-s", str(limit), "must be > 0 (CPU seconds per job)")
     if scheduler:
         if name != "dask":
             raise ConfigError("--scheduler", scheduler, f"a scheduler address needs --executor dask (not {name})")

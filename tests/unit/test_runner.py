@@ -141,3 +141,8 @@ def test_cli_run_with_fake_yade(tmp_path, fake_yade, capsys):
     rc = main(["run", "fill", "--material", "M2", "--seeds", "2", "--replicas", "1", "--out", str(tmp_path / "runs")])
     out = capsys.readouterr().out
     assert rc == 0 and "bulk_density_kg_m3=1600" in out and "over 2 seeds" in out
+
+
+def test_a_cpu_limit_not_above_zero_is_refused(tmp_path):
+    assert main(["run", "fill", "--material", "M2", "--cpu-limit-s", "0", "--out", str(tmp_path / "r")]) == 2
+    assert not (tmp_path / "r").exists()
