@@ -51,7 +51,17 @@ def table(title, head, rows):
     return out + [""]
 
 
-def profile(rows):
+def stage_elapsed(study_dir):
+    """{section: wall s} of the stages from the study's stages.csv (its own clock)."""
+    path = Path(study_dir) / "stages.csv"
+    if not path.is_file():
+        return {}
+    with open(path) as f:
+        return {f"{r['material']}/{r['stage']}": float(r["elapsed_s"]) for r in csv.DictReader(f)
+                if r.get("elapsed_s")}
+
+
+def profile(rows, elapsed=None):
     by_section = defaultdict(lambda: {"jobs": 0, "failed": 0, "cpu": 0.0, "wall": 0.0, "per_run": []})
     by_rig = defaultdict(lambda: {"jobs": 0, "cpu": 0.0, "steps": 0.0, "sim": 0.0})
     by_phase = defaultdict(lambda: defaultdict(lambda: [0.0, 0.0, 0.0]))
@@ -79,9 +89,12 @@ def profile(rows):
     total = sum(s["cpu"] for s in by_section.values()) or 1.0
     out = [f"Total CPU {total:.0f} s ({total / 3600:.2f} CPU-h) over {sum(s['jobs'] for s in by_section.values())} "
            "distinct jobs.", ""]
-    out += table("Per section", ["section", "jobs", "failed", "CPU s", "share", "CPU s per run, median", "wall s (sum)"],
+    elapsed = elapsed or {}
+    out += table("Per section", ["section", "jobs", "failed", "CPU s", "share", "CPU s per run, median",
+                                 "stage wall s (study clock)"],
                  [(k, s["jobs"], s["failed"], f"{s['cpu']:.0f}", f"{s['cpu'] / total:.1%}",
-                   f"{statistics.median(s['per_run']):.1f}" if s["per_run"] else "-", f"{s['wall']:.0f}")
+                   f"{statistics.median(s['per_run']):.1f}" if s["per_run"] else "-",
+                   f"{elapsed[k]:.0f}" if k in elapsed else "-")
                   for k, s in by_section.items()])
     out += table("Per rig", ["rig", "jobs", "CPU s", "share", "CPU s per job", "time steps (M)", "simulated s"],
                  [(k, g["jobs"], f"{g['cpu']:.0f}", f"{g['cpu'] / total:.1%}", f"{g['cpu'] / max(1, g['jobs']):.1f}",
@@ -107,7 +120,7 @@ def main(argv=None):
     if not (study / "jobs.csv").is_file():
         raise SystemExit(f"cost_profile: {study / 'jobs.csv'}: no such file (a study output folder written by "
                          "./run.sh calibrate)")
-    text = profile(load(study, Path(args.runs) if args.runs else study.parent.parent))
+    text = profile(load(study, Path(args.runs) if args.runs else study.parent.parent), stage_elapsed(study))
     print(text)
     if args.out:
         Path(args.out).write_text(text + "\n")

@@ -36,6 +36,6 @@ def test_profile_adds_up_sections_rigs_and_phases(tmp_path):
     assert len(rows) == 4 and [share for _, _, share in rows][:2] == [0.5, 0.5]
     text = cost.profile(rows)
     assert "Total CPU 110 s" in text
-    assert "| M2/density | 2 | 0 | 10 | 9.1% | 5.0 |" in text
+    assert "| M2/density | 2 | 0 | 10 | 9.1% | 5.0 | - |" in text
     assert "| M2/wall_friction | 2 | 1 | 100 | 90.9% | 100.0 |" in text
     assert "| tilt_static | 60 | 60.0% | 95% | 0.20 | 285 |" in text
