@@ -15,14 +15,15 @@ import argparse
 import json
 import math
 import statistics
-from collections import defaultdict
+import sys
 from pathlib import Path
 
 import numpy as np
 
-from pycal.post.aor import read_positions_csv
-from pycal.post.aor_readings import READINGS
-from pycal.replicas import expand
+sys.path.insert(0, str(Path(__file__).resolve().parent.parent))
+from pycal.post.aor import read_positions_csv  # noqa: E402
+from pycal.post.aor_readings import READINGS  # noqa: E402
+from pycal.replicas import expand  # noqa: E402
 
 ETA_KEY = "interactions.M2.rolling_resistance_coefficient"
 
