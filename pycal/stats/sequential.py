@@ -51,20 +51,6 @@ def second_point_u(u0, y0, target, increasing, slope_per_u=None, lo_u=0.0, hi_u=
     return float(np.clip(u1, lo_u, hi_u))
 
 
-def bracket_midpoint(scale, points, target, increasing, noise_sd=0.0, counts=None):
-    """Midpoint (in u) of the innermost pair of points (x, mean response) whose means lie
-    clearly on either side of the target (by more than 2 standard errors, noise_sd /
-    sqrt(runs at the point); counts: runs per point), or None when no such pair exists."""
-    counts = counts or [1] * len(points)
-    margin = [2.0 * noise_sd / math.sqrt(n) for n in counts]
-    below = [x for (x, m), d in zip(points, margin) if m < target - d]
-    above = [x for (x, m), d in zip(points, margin) if m > target + d]
-    if not below or not above:
-        return None
-    a, b = (max(below), min(above)) if increasing else (min(below), max(above))
-    return float(scale.from_unit(0.5 * (float(scale.to_unit(a)) + float(scale.to_unit(b)))))
-
-
 @single_threaded
 def step_1d(scale, x, y, target, increasing, tolerance=None, tolerance_percent=None, standard_error=0.0,
             band=0.0, runs_left=None, runs_per_point=3, lo_u=0.0, hi_u=1.0, seed=0, standard_error_dof=math.inf):
@@ -81,7 +67,6 @@ def step_1d(scale, x, y, target, increasing, tolerance=None, tolerance_percent=N
     edge = 0.01 * (hi_u - lo_u)
     xa, ya = np.asarray(x, dtype=float), np.asarray(y, dtype=float)
     points = [(float(v), float(np.mean(ya[xa == v]))) for v in np.unique(xa)]
-    counts = [int(np.sum(xa == v)) for v in np.unique(xa)]
     stop = stopping.stop_reason(est, low, high, tol, inv.p_below, inv.p_above,
                                 ran_at_lower=bool(np.any(u <= lo_u + edge)),
                                 ran_at_upper=bool(np.any(u >= hi_u - edge)),
@@ -95,14 +80,8 @@ def step_1d(scale, x, y, target, increasing, tolerance=None, tolerance_percent=N
         if (side and stopping.within_tolerance(est, low, high, tol)
                 and inv.p_below <= stopping.BOUND_SHARE and inv.p_above <= stopping.BOUND_SHARE):
             # precise enough on paper, but no point ran inside the interval on that side of
-            # the estimate: bisect (in u) between the nearest points whose means lie clearly
-            # on either side of the target (the data's own bracket) if that has not run yet,
-            # else run halfway between the estimate and the interval's end on that side
-            mid = bracket_midpoint(scale, points, target, increasing, model.noise_sd, counts)
-            ran = any(abs(float(scale.to_unit(mid)) - float(scale.to_unit(v))) < 1e-3 for v, _ in points) \
-                if mid is not None else True
-            out.next_x = mid if not ran else float(scale.from_unit(0.5 * (inv.estimate_u + (
-                inv.low_u if side < 0 else inv.high_u))))
+            # the estimate: run there, halfway (in u) between the estimate and that end
+            out.next_x = float(scale.from_unit(0.5 * (inv.estimate_u + (inv.low_u if side < 0 else inv.high_u))))
         else:
             out.next_x = float(scale.from_unit(design.next_point_1d(model, inv.crossings_u, lo_u, hi_u,
                                                                     runs_per_point)))
