@@ -24,6 +24,7 @@ sys.path.insert(0, str(Path(__file__).resolve().parent.parent))
 from pycal.post.aor import read_positions_csv  # noqa: E402
 from pycal.post.aor_readings import READINGS  # noqa: E402
 from pycal.replicas import expand  # noqa: E402
+from pycal.files import write_text  # noqa: E402
 
 ETA_KEY = "interactions.M2.rolling_resistance_coefficient"
 
@@ -93,7 +94,7 @@ def main(argv=None):
     text = "\n".join(lines)
     print(text)
     if args.out:
-        Path(args.out).write_text(text + "\n")
+        write_text(Path(args.out), text + "\n")      # atomic, the project's writer
 
 
 if __name__ == "__main__":

@@ -18,8 +18,12 @@ import argparse
 import csv
 import json
 import statistics
+import sys
 from collections import defaultdict
 from pathlib import Path
+
+sys.path.insert(0, str(Path(__file__).resolve().parent.parent))
+from pycal.files import write_text  # noqa: E402
 
 
 def load(study_dir, runs_dir):
@@ -123,7 +127,7 @@ def main(argv=None):
     text = profile(load(study, Path(args.runs) if args.runs else study.parent.parent), stage_elapsed(study))
     print(text)
     if args.out:
-        Path(args.out).write_text(text + "\n")
+        write_text(Path(args.out), text + "\n")      # atomic, the project's writer
 
 
 if __name__ == "__main__":

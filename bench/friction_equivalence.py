@@ -20,9 +20,13 @@ import argparse
 import json
 import math
 import statistics
+import sys
 from pathlib import Path
 
 import yaml
+
+sys.path.insert(0, str(Path(__file__).resolve().parent.parent))
+from pycal.files import write_text  # noqa: E402
 
 MIN_STRESS_PA = 10000.0
 
@@ -132,7 +136,7 @@ def main(argv=None):
     text = "\n".join(lines)
     print(text)
     if args.out:
-        Path(args.out).write_text(text + "\n")
+        write_text(Path(args.out), text + "\n")      # atomic, the project's writer
 
 
 if __name__ == "__main__":
