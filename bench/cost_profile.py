@@ -31,10 +31,6 @@ def load(study_dir, runs_dir):
     rows, seen = [], set()
     with open(Path(study_dir) / "jobs.csv") as f:
         jobs = list(csv.DictReader(f))
-    batch_sizes = defaultdict(set)
-    for j in jobs:
-        if j.get("batch_job_id"):
-            batch_sizes[j["batch_job_id"]].add(j["seed"])
     for j in jobs:
         if j["job_id"] in seen:
             continue
@@ -42,9 +38,7 @@ def load(study_dir, runs_dir):
         folder = j.get("batch_job_id") or j["job_id"]
         path = Path(runs_dir) / j["rig"] / folder / "result.json"
         result = json.loads(path.read_text()) if path.is_file() and j["status"] == "ok" else None
-        share = 1.0 / len(batch_sizes[folder]) if j.get("batch_job_id") else 1.0
-        if result is not None and "replicas" in result:
-            share = 1.0 / max(1, len(result["replicas"]))
+        share = 1.0 / max(1, len(result["replicas"])) if result is not None and "replicas" in result else 1.0
         rows.append((j, result, share))
     return rows
 
@@ -66,7 +60,7 @@ def stage_elapsed(study_dir):
 
 
 def profile(rows, elapsed=None):
-    by_section = defaultdict(lambda: {"jobs": 0, "failed": 0, "cpu": 0.0, "wall": 0.0, "per_run": []})
+    by_section = defaultdict(lambda: {"jobs": 0, "failed": 0, "cpu": 0.0, "per_run": []})
     by_rig = defaultdict(lambda: {"jobs": 0, "cpu": 0.0, "steps": 0.0, "sim": 0.0})
     by_phase = defaultdict(lambda: defaultdict(lambda: [0.0, 0.0, 0.0]))
     for j, r, share in rows:
@@ -78,7 +72,6 @@ def profile(rows, elapsed=None):
         p = r.get("provenance") or {}
         cpu = (p.get("cpu_time_s") or 0.0) * share
         s["cpu"] += cpu
-        s["wall"] += (p.get("wall_time_s") or 0.0) * share
         s["per_run"].append(cpu)
         g = by_rig[j["rig"]]
         g["jobs"] += 1

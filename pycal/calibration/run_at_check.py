@@ -15,6 +15,7 @@ import math
 
 from ..files import write_csv
 from ..jobs import resolve_job
+from ..post import mean_std
 from ..post import responses as responses_mod
 
 COLUMNS = ["material", "stage", "rig", "response", "run_at", "calibrated_at", "value_mean", "value_sd", "n",
@@ -53,10 +54,7 @@ def run(study):
         jobs += [resolve_job(spec["rig"], material, over, seed=s) for s in seeds]
     study.runs_requested += len(jobs)
     results = study.executor.run(jobs, raise_on_error=False)
-    study.jobs += [{"section": "run_at_check", "material": j["material"], "rig": j["rig"], "seed": j["seed"],
-                    "job_id": j["job_id"], "status": "ok" if r is not None else "failed",
-                    "batch_job_id": ((r or {}).get("provenance") or {}).get("batch_job_id", "")}
-                   for j, r in zip(jobs, results)]
+    study.record_jobs(jobs, results)
     rows = []
     for i, (material, st, spec, stage_row, k) in enumerate(todo):
         res = [r for r in results[i * len(seeds):(i + 1) * len(seeds)] if r is not None]
@@ -71,9 +69,11 @@ def run(study):
         vals = [v for v in vals if not math.isnan(v)]
         if not res:
             error = error or "every run failed"
-        mean = sum(vals) / len(vals) if vals else math.nan
-        sd = (math.sqrt(sum((v - mean) ** 2 for v in vals) / (len(vals) - 1)) if len(vals) > 1 else math.nan)
-        resp_row = (stage_row.get("responses") or [{}])[k] if k < len(stage_row.get("responses") or []) else {}
+        mean, sd = mean_std(vals) if vals else (math.nan, math.nan)
+        if len(vals) < 2:
+            sd = math.nan                # one run has no spread (mean_std would say 0)
+        responses = stage_row.get("responses") or []
+        resp_row = responses[k] if k < len(responses) else {}
         at_values = {key: study.overrides[material].get(key) for key in st["run_at"]}
         rows.append({"material": material, "stage": st["label"], "rig": spec["rig"], "response": spec["response"],
                      "run_at": st["run_at"], "calibrated_at": at_values, "value_mean": mean, "value_sd": sd,

@@ -14,8 +14,8 @@ stage fits). Levels: the calibrated value (low) and the value x (1 + relative_st
 - design `screening` (default): a Plackett-Burman design (pycal.stats.screening): N runs
   (N the smallest multiple of 4 above the factor count), each on the same seeds_per_run
   seeds, so every run informs every effect. Effect = mean at high - mean at low; its
-  standard error from the design's unused columns (and from the seed spread of the rows
-  when seeds_per_run > 1). N x seeds_per_run runs in all.
+  standard error from the design's unused columns (none when the factors fill every
+  column). N x seeds_per_run runs in all.
 - design `one-at-a-time`: each factor alone at its high level on the validation's seeds
   (validation.sensitivity.seeds_count), paired seed by seed with the prediction's own
   runs at the calibrated values: factors x seeds runs.
@@ -33,7 +33,7 @@ from ..jobs import override_value, resolve_job
 from ..plotting import new_figure, save_png
 from ..stats import screening
 from .calibrated import run_overrides
-from .validation import CURVE, compare_results, movable, paired_change
+from .validation import compare_results, movable, paired_change
 
 DESIGNS = ("screening", "one-at-a-time")
 
@@ -80,18 +80,15 @@ def moved(extra, factor, step):
 
 
 def response_of(results, cmp):
-    """Mean response of one design row's runs (a curve comparison: the mean RMS band z)."""
-    if cmp["response"] == CURVE:
-        return compare_results(results, cmp)["sim_mean"]
-    vals = [r.get(cmp["response"]) for r in results]
-    vals = [v for v in vals if isinstance(v, (int, float)) and not math.isnan(v)]
-    return float(np.mean(vals)) if vals else math.nan
+    """Mean response of one design row's runs, as the validation compares it (a curve
+    comparison: the mean RMS band z); NaN when no run gave a value."""
+    return compare_results(results, cmp)["sim_mean"]
 
 
 def run_screening(study, pred, extra, facs, step, seeds, cmp):
     """The Plackett-Burman rows on `seeds` each; returns the factor rows (effect, se)."""
     design = screening.plackett_burman(len(facs))
-    ys, row_sds = [], []
+    ys = []
     for i, levels in enumerate(design):
         over = dict(extra)
         for f, lev in zip(facs, levels):

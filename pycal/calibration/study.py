@@ -103,10 +103,7 @@ class Study:
             attempted += len(jobs)
             out = self.executor.run(jobs, raise_on_error=False)
             errors = list(getattr(self.executor, "last_errors", []))
-            self.jobs += [{"section": self.section, "material": material, "rig": rig, "seed": j["seed"],
-                           "job_id": j["job_id"], "status": "ok" if r is not None else "failed",
-                           "batch_job_id": ((r or {}).get("provenance") or {}).get("batch_job_id", "")}
-                          for j, r in zip(jobs, out)]
+            self.record_jobs(jobs, out)
             slots = [s for s in wanted if s not in results]
             retry = []
             for slot, seed, r in zip(slots, batch, out):
@@ -126,6 +123,14 @@ class Study:
             next_seed += len(retry)
         self.last_seeds = [used[s] for s in wanted]
         return [results[s] for s in wanted]
+
+    def record_jobs(self, jobs, results):
+        """Note every job asked (with its result or None) in the jobs ledger (jobs.csv), under
+        the current section."""
+        self.jobs += [{"section": self.section, "material": j["material"], "rig": j["rig"], "seed": j["seed"],
+                       "job_id": j["job_id"], "status": "ok" if r is not None else "failed",
+                       "batch_job_id": ((r or {}).get("provenance") or {}).get("batch_job_id", "")}
+                      for j, r in zip(jobs, results)]
 
     def _drop_missing(self, values, results, rig, response, extra):
         """Leave out the seeds whose scalar response has no value (NaN: e.g. a pile too flat

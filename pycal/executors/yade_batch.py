@@ -33,7 +33,7 @@ from .base import Executor, say
 from .jobdirs import (cached_failure, cached_result, create_job_folder, finish, log_tail, prepare_temp,
                       temp_suffix)
 from .yade_process import (CPU_LIMIT_EXIT_CODES, WALL_LIMIT_FACTOR, cpu_limit_message, cpu_limited,
-                           die_with_parent, yade_env, yade_executable)
+                           die_with_parent, wall_limit_message, yade_env, yade_executable)
 
 # yade-batch cuts log paths longer than this (and then cannot write the log)
 MAX_LOG_PATH_CHARS = 230
@@ -222,8 +222,8 @@ class YadeBatch(Executor):
         """Complete one line from its wait status (as os.system gives it)."""
         code = status >> 8 if status > 0 else status
         if code == _KILLED_BY_TIMEOUT and elapsed >= WALL_LIMIT_FACTOR * self.timeout_s - 2:
-            tail = f"no result after {WALL_LIMIT_FACTOR * self.timeout_s:g} s of wall time (hung?)"
-        elif code in CPU_LIMIT_EXIT_CODES[:2]:
+            tail = wall_limit_message(self.timeout_s)
+        elif code in CPU_LIMIT_EXIT_CODES:
             tail = cpu_limit_message(self.timeout_s)
         elif code:
             tail = f"exit code {code}: {log_tail(tmp / LOG_FILE)}"

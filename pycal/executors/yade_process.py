@@ -42,7 +42,7 @@ def die_with_parent(cmd):
 # of its core on an overloaded machine is slow, not broken. The wall clock only stops a
 # run that has not used its CPU time in this many times its limit (a hung process).
 WALL_LIMIT_FACTOR = 10.0
-CPU_LIMIT_EXIT_CODES = (-signal.SIGXCPU, 128 + signal.SIGXCPU, -signal.SIGKILL)   # as Popen / a shell see them
+CPU_LIMIT_EXIT_CODES = (-signal.SIGXCPU, 128 + signal.SIGXCPU)   # SIGXCPU as Popen / a shell see it
 
 
 def cpu_limited(cmd, cpu_limit_s):
@@ -58,6 +58,11 @@ def cpu_limited(cmd, cpu_limit_s):
 def cpu_limit_message(cpu_limit_s):
     return (f"CPU time limit of {cpu_limit_s:g} s reached (--cpu-limit-s; the run itself is not known to "
             "be broken: a stiffer material or a longer procedure needs more)")
+
+
+def wall_limit_message(cpu_limit_s):
+    return (f"no result after {WALL_LIMIT_FACTOR * cpu_limit_s:g} s of wall time ({WALL_LIMIT_FACTOR:g} x "
+            f"the CPU limit): the process hung or the machine is far overloaded")
 
 
 def run_job(job, runs_dir=DEFAULT_RUNS_DIR, timeout_s=3600):
@@ -88,9 +93,8 @@ def run_job(job, runs_dir=DEFAULT_RUNS_DIR, timeout_s=3600):
     if rc != 0:
         (tmp / RESULT_FILE).unlink(missing_ok=True)
         if rc == "timeout":
-            tail = (f"no result after {WALL_LIMIT_FACTOR * timeout_s:g} s of wall time ({WALL_LIMIT_FACTOR:g} x "
-                    f"the CPU limit): the process hung or the machine is far overloaded")
-        elif rc in CPU_LIMIT_EXIT_CODES[:2]:
+            tail = wall_limit_message(timeout_s)
+        elif rc in CPU_LIMIT_EXIT_CODES:
             tail = cpu_limit_message(timeout_s)
         else:
             tail = f"exit code {rc}: {log_tail(tmp / LOG_FILE)}"

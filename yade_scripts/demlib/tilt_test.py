@@ -261,22 +261,19 @@ def tilt_test(scene, tilt, cell, lid, plate_ids, spill_box, proc, record, step_i
     run = TiltRecorder(scene, tilt, cell, plate_ids, spill_box, record, step_index, proc["record_interval_s"])
     with CLOCK.phase("tilt_static"):
         out, angle = static_onset(run, proc)
-    if out["onset_angle_deg"] is not None and not proc["measure_dynamic_friction"]:
-        # static friction only (a calibration stage that reads mu_static): the step ends at
-        # the onset; everything up to it is the same computation as with the hold
-        out.update({"mu_dynamic": None, "dynamic_angle_deg": None, "dynamic_travel_time_s": None,
-                    "dynamic_restarts_count": 0, "plate_force_ratio_sliding": None})
-        sticks = False
-    elif out["onset_angle_deg"] is not None:
+    slid = out["onset_angle_deg"] is not None
+    if slid and proc["measure_dynamic_friction"]:
         if mode == "undamped_when_sliding":
             set_damped(scene.sphere_ids, False)
         with CLOCK.phase("tilt_dynamic"):
             out.update(dynamic_travel(run, proc, angle))
         sticks = out["dynamic_travel_time_s"] is None
     else:
+        # no onset up to max_tilt_deg (the cell sticks), or static friction only (a stage that
+        # reads mu_static: the step ends at the onset, the same computation up to it)
         out.update({"mu_dynamic": None, "dynamic_angle_deg": None, "dynamic_travel_time_s": None,
                     "dynamic_restarts_count": 0, "plate_force_ratio_sliding": None})
-        sticks = True
+        sticks = not slid
     onset = out["onset_angle_deg"]
     out.update({
         "mu_static": math.tan(math.radians(onset)) if onset is not None else None,
