@@ -49,13 +49,16 @@ def next_point_1d(model, crossings_u, lo_u, hi_u, runs_count):
 @single_threaded
 def next_point_nd(models, samples_u, runs_count, rng, avoid=()):
     """u (d,) of the next point of a joint stage: the candidate (drawn from the posterior
-    samples, plus the posterior median) that most reduces the variance of every output,
-    each output's reduction relative to its current variance at the samples (and, as in
+    samples inside the box of the 95 % marginal intervals, plus the posterior median) that
+    most reduces the variance of every output, each output's reduction relative to its current variance at the samples (and, as in
     1-D, a far candidate keeps exp(-d^2 / 2 DISTANCE_SCALE_U^2) of its gain). avoid:
     (centre, radius) balls in u around points the rig refused: no candidate there."""
     S = np.asarray(samples_u, dtype=float)
     ref = S[rng.choice(len(S), size=min(len(S), 60), replace=False)]
     cand = np.vstack([np.median(S, axis=0)[None, :], S[rng.choice(len(S), size=min(len(S), 80), replace=False)]])
+    # points go where the intervals are: inside the box of the 2.5 - 97.5 % marginals
+    low, high = np.percentile(S, 2.5, axis=0), np.percentile(S, 97.5, axis=0)
+    cand = cand[np.all((cand >= low[None, :]) & (cand <= high[None, :]), axis=1)]
     for centre, radius in avoid:
         cand = cand[np.linalg.norm(cand - np.asarray(centre)[None, :], axis=1) > radius]
     if not len(cand):

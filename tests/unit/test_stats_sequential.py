@@ -146,9 +146,11 @@ def test_joint_next_point_is_inside_the_posterior_and_avoids_refused_points():
     # (on the unit scales x = u); a ball over the whole posterior leaves no candidate
     refused = np.array(st.next_x)
     for radius in (0.03, 0.05):
-        nxt = next_point_nd(st.models, st.samples, 3, np.random.default_rng(0), avoid=[(refused, radius)])
-        assert np.linalg.norm(nxt - refused) > radius
-        assert all(lo <= x <= hi for lo, x, hi in zip(st.low, nxt, st.high))
+        for candidate_seed in range(8):
+            nxt = next_point_nd(st.models, st.samples, 3, np.random.default_rng(candidate_seed),
+                                avoid=[(refused, radius)])
+            assert np.linalg.norm(nxt - refused) > radius
+            assert all(lo <= x <= hi for lo, x, hi in zip(st.low, nxt, st.high))
     assert next_point_nd(st.models, st.samples, 3, np.random.default_rng(0), avoid=[(refused, 1.5)]) is None
 
 
