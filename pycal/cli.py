@@ -3,7 +3,6 @@
 Every user error prints one line `error: <file>: <field>: <reason>` and exits 2;
 a failed simulation exits 3.
 """
-import argparse
 import json
 import sys
 
@@ -114,7 +113,8 @@ def _cmd_impact(args):
 
 def build_parser():
     from .executors import DEFAULT_RUNS_DIR, add_executor_args
-    p = argparse.ArgumentParser(prog="pycal", description="DEM calibration toolkit (YADE)")
+    from .arguments import OneLineParser
+    p = OneLineParser(prog="pycal", description="DEM calibration toolkit (YADE)")
     sub = p.add_subparsers(dest="command", required=True)
 
     s = sub.add_parser("validate", help="validate every config and lab-data file")
@@ -179,6 +179,8 @@ def main(argv=None):
     parser = build_parser()
     args = parser.parse_args(argv)
     try:
+        from . import arguments
+        arguments.check(args)
         args.func(args)
     except ConfigError as exc:
         print(f"error: {exc}", file=sys.stderr)

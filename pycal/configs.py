@@ -5,12 +5,13 @@ Every error names the file, the dotted key and the reason, e.g.
 Unknown keys are errors, never silently ignored.
 """
 import copy
+import math
 import re
 from pathlib import Path
 
 import yaml
 
-from . import CONFIG_DIR
+from . import CONFIG_DIR, plausible
 from .contact_rules import COHESION_MODELS, CONTACT_MODELS
 from .errors import ConfigError
 
@@ -85,10 +86,20 @@ class _Checker:
     def number(self, value, key, lo=None, hi=None, lo_open=False):
         if isinstance(value, bool) or not isinstance(value, (int, float)):
             self.fail(key, f"{value!r} must be a number")
+        if not math.isfinite(value):
+            self.fail(key, f"{value!r} must be a finite number")
         if lo is not None and (value <= lo if lo_open else value < lo):
             self.fail(key, f"{value} must be {'>' if lo_open else '>='} {lo}")
         if hi is not None and value > hi:
             self.fail(key, f"{value} must be <= {hi}")
+        return float(value)
+
+    def plausible(self, value, key, lo=None, hi=None, lo_open=False):
+        """number() and then the plausible range of the key (pycal/plausible.py)."""
+        self.number(value, key, lo, hi, lo_open)
+        why = plausible.check(key, value)
+        if why:
+            self.fail(key, why)
         return float(value)
 
     def string(self, value, key, choices=None):
@@ -111,9 +122,9 @@ def load_boundaries(config_dir=CONFIG_DIR):
     for name, b in data.items():
         c.keys(b, name, ["density_kg_m3", "youngs_modulus_pa", "poisson_ratio"],
                ["description", "provenance"])
-        c.number(b["density_kg_m3"], f"{name}.density_kg_m3", 0, lo_open=True)
-        c.number(b["youngs_modulus_pa"], f"{name}.youngs_modulus_pa", 0, lo_open=True)
-        c.number(b["poisson_ratio"], f"{name}.poisson_ratio", -1, 0.5)
+        c.plausible(b["density_kg_m3"], f"{name}.density_kg_m3", 0, lo_open=True)
+        c.plausible(b["youngs_modulus_pa"], f"{name}.youngs_modulus_pa", 0, lo_open=True)
+        c.plausible(b["poisson_ratio"], f"{name}.poisson_ratio", -1, 0.5)
     return data
 
 
@@ -129,17 +140,17 @@ def validate_material(data, path, partners):
     p = data["particles"]
     c.keys(p, "particles", ["shape", "density_kg_m3"], ["diameter_m", "size_classes", "shapes"])
     shape = c.string(p["shape"], "particles.shape", ["sphere", "clump"])
-    c.number(p["density_kg_m3"], "particles.density_kg_m3", 0, lo_open=True)
+    c.plausible(p["density_kg_m3"], "particles.density_kg_m3", 0, lo_open=True)
     if shape == "sphere":
         if "diameter_m" not in p:
             c.fail("particles.diameter_m", "missing (required for shape: sphere)")
-        c.number(p["diameter_m"], "particles.diameter_m", 0, lo_open=True)
+        c.plausible(p["diameter_m"], "particles.diameter_m", 0, lo_open=True)
     else:
         _validate_clump_particles(c, p)
     k = data["contact"]
     c.keys(k, "contact", ["youngs_modulus_pa", "poisson_ratio"])
-    c.number(k["youngs_modulus_pa"], "contact.youngs_modulus_pa", 0, lo_open=True)
-    c.number(k["poisson_ratio"], "contact.poisson_ratio", -1, 0.5)
+    c.plausible(k["youngs_modulus_pa"], "contact.youngs_modulus_pa", 0, lo_open=True)
+    c.plausible(k["poisson_ratio"], "contact.poisson_ratio", -1, 0.5)
     inter = data["interactions"]
     if not isinstance(inter, dict):
         c.fail("interactions", "must be a mapping partner -> properties")
@@ -170,8 +181,8 @@ def _validate_clump_particles(c, p):
     for i, sc in enumerate(p["size_classes"]):
         key = f"particles.size_classes[{i}]"
         c.keys(sc, key, ["name", "min_size_m", "max_size_m", "mass_percent", "shape_percent"])
-        lo = c.number(sc["min_size_m"], f"{key}.min_size_m", 0, lo_open=True)
-        hi = c.number(sc["max_size_m"], f"{key}.max_size_m", 0, lo_open=True)
+        lo = c.plausible(sc["min_size_m"], f"{key}.min_size_m", 0, lo_open=True)
+        hi = c.plausible(sc["max_size_m"], f"{key}.max_size_m", 0, lo_open=True)
         if hi <= lo:
             c.fail(f"{key}.max_size_m", f"{hi} must be > min_size_m {lo}")
         total += c.number(sc["mass_percent"], f"{key}.mass_percent", 0, 100)
@@ -245,13 +256,8 @@ NUMERICS_CHOICES = {
 }
 
 
-def check_numerics_choices(numerics, c, prefix=""):
-    for k, allowed in NUMERICS_CHOICES.items():
-        if k in numerics:
-            c.string(numerics[k], prefix + k, list(allowed))
-
-
 def load_numerics(config_dir=CONFIG_DIR):
+    from . import rigs
     path = Path(config_dir) / "numerics.yaml"
     data = load_yaml(path)
     c = _Checker(path)
@@ -259,7 +265,7 @@ def load_numerics(config_dir=CONFIG_DIR):
     for k in NUMERICS_CHOICES:
         if k not in data:
             c.fail(k, f"missing (one of {', '.join(NUMERICS_CHOICES[k])})")
-    check_numerics_choices(data, c)
+    rigs.check_numerics(data, _rel(path))
     return data
 
 
@@ -268,30 +274,18 @@ def rig_names(config_dir=CONFIG_DIR):
 
 
 def load_rig(name, config_dir=CONFIG_DIR):
-    """One validated rig config by name, with the shared numerics merged in."""
+    """One validated rig config by name, with the shared numerics merged in: checked
+    against the rig's descriptor (pycal/rigs/<name>.py: every key, its type and range)."""
+    from . import rigs
     path, _ = _config_file(config_dir, "rigs", name, "rig")
     data = load_yaml(path)
     c = _Checker(path)
-    c.keys(data, "", ["name", "script", "geometry", "procedure"],
-           ["description", "measure", "assumptions", "numerics", "accepts_material_sets"])
+    c.keys(data, "", ["name", "script", "geometry", "procedure"], ["description", "measure", "assumptions", "numerics"])
     if data["name"] != name:
         c.fail("name", f"{data['name']!r} must equal the file name {name!r}")
-    c.string(data["script"], "script")
-    if "accepts_material_sets" in data and not isinstance(data["accepts_material_sets"], bool):
-        c.fail("accepts_material_sets", f"{data['accepts_material_sets']!r} must be true or false")
-    for section in ("geometry", "procedure", "measure", "numerics"):
-        if section in data and not isinstance(data[section], dict):
-            c.fail(section, "must be a mapping")
     check_rig_keys(data, c)
-    boundaries = load_boundaries_cached(config_dir)
-    for k, v in data["geometry"].items():
-        if k.endswith("_material") and v not in boundaries:
-            c.fail(f"geometry.{k}", f"unknown boundary {v!r} (known: {', '.join(boundaries)})")
     numerics = load_numerics(config_dir)
-    for k in data.get("numerics", {}):
-        if k not in numerics:
-            c.fail(f"numerics.{k}", f"unknown key (allowed: {', '.join(numerics)})")
-    check_numerics_choices(data.get("numerics", {}), c, "numerics.")
+    rigs.check_config(data, _rel(path), tuple(load_boundaries_cached(config_dir)), tuple(numerics))
     merged = copy.deepcopy(data)
     merged["numerics"] = {**numerics, **data.get("numerics", {})}
     return merged
@@ -316,10 +310,9 @@ def _check_pair_props(c, props, key):
     Whether the scene's contact law can realise them is checked per job (pycal.contact_rules)."""
     c.keys(props, key, ["friction_coefficient", "restitution_coefficient", "rolling_resistance_coefficient",
                         "cohesion"])
-    c.number(props["friction_coefficient"], f"{key}.friction_coefficient", 0)
-    # below ~0.1 a DEM contact dashpot is close to critical and the solver may become unstable
-    c.number(props["restitution_coefficient"], f"{key}.restitution_coefficient", 0.05, 1.0)
-    c.number(props["rolling_resistance_coefficient"], f"{key}.rolling_resistance_coefficient", 0)
+    c.plausible(props["friction_coefficient"], f"{key}.friction_coefficient", 0)
+    c.plausible(props["restitution_coefficient"], f"{key}.restitution_coefficient", 0.05, 1.0)
+    c.plausible(props["rolling_resistance_coefficient"], f"{key}.rolling_resistance_coefficient", 0)
     coh = props["cohesion"]
     if not isinstance(coh, dict) or "model" not in coh:
         c.fail(f"{key}.cohesion", "must be a mapping with a 'model' key")
@@ -327,7 +320,7 @@ def _check_pair_props(c, props, key):
     params = COHESION_MODELS[model]["params"]
     c.keys(coh, f"{key}.cohesion", ["model"] + list(params))
     for pname, (lo, hi) in params.items():
-        c.number(coh[pname], f"{key}.cohesion.{pname}", lo, hi)
+        c.plausible(coh[pname], f"{key}.cohesion.{pname}", lo, hi)
 
 
 def _take_from_components(c, data, materials):

@@ -16,3 +16,7 @@ class ConfigError(PycalError):
 
 class RunError(PycalError):
     """A YADE run failed (blew up, timed out, wrote no result)."""
+
+
+class BudgetSpent(PycalError):
+    """A study's run budget (max_runs_count) does not allow the runs asked for."""

@@ -15,12 +15,12 @@ import yaml
 
 from . import CONFIG_DIR
 from .configs import (parse_yaml_text, load_boundaries_cached, load_material, load_rig, material_names,
-                      validate_material, check_rig_keys, check_numerics_choices, _Checker)
+                      validate_material, check_rig_keys, _Checker)
 from .configs import (SET_DIR, component_value, load_yaml, material_set_names, put_component_value, rig_names,
                       validate_material_set)
 from .contact_rules import ContactRuleError, check_job
 from .errors import ConfigError
-from . import step_estimate
+from . import rigs, step_estimate
 
 JOB_FORMAT = 1
 
@@ -86,16 +86,15 @@ def resolve_job(rig, material, overrides=None, seed=1, config_dir=CONFIG_DIR):
         else:
             _set_path(mat, key, value, f"overrides of configs/materials/{material}.yaml")
     partners = set(material_names(config_dir)) | set(load_boundaries_cached(config_dir))
-    validate_material(mat, f"configs/materials/{material}.yaml (with overrides)", partners)
-    rig_checker = _Checker(f"configs/rigs/{rig}.yaml (with overrides)")
-    check_rig_keys(rig_cfg, rig_checker)
-    check_numerics_choices(rig_cfg["numerics"], rig_checker, "numerics.")
+    with blame_override(overrides, ""):
+        validate_material(mat, f"configs/materials/{material}.yaml (with overrides)", partners)
+    check_rig_with_overrides(rig, rig_cfg, overrides, config_dir)
     return _finish_job(rig, rig_cfg, seed, material, {material: mat}, overrides, config_dir)
 
 
 def resolve_set_job(rig, set_name, overrides=None, seed=1, config_dir=CONFIG_DIR):
     """Job of a material set (configs/material_sets/<set_name>.yaml) on a rig that
-    accepts sets (`accepts_material_sets: true` in its config).
+    accepts sets (accepts_material_sets in its descriptor, pycal/rigs/<rig>.py).
 
     job["material"] = the set's name; job["materials"] = every component material (in
     the set's order) with the set's cross_interactions written into both materials of
@@ -106,11 +105,10 @@ def resolve_set_job(rig, set_name, overrides=None, seed=1, config_dir=CONFIG_DIR
     set (e.g. 'cross_interactions.M2.M3-wet.cohesion.force_fraction').
     """
     rig_cfg = load_rig(rig, config_dir)
-    if not rig_cfg.get("accepts_material_sets", False):
-        takers = [r for r in rig_names(config_dir) if load_rig(r, config_dir).get("accepts_material_sets", False)]
-        raise ConfigError(f"configs/rigs/{rig}.yaml", "accepts_material_sets",
-                          f"rig {rig} takes one material, and {set_name} is a material set "
-                          f"(rigs that take sets: {', '.join(takers) or 'none'})")
+    if not rigs.get(rig).accepts_material_sets:
+        takers = [r for r in rig_names(config_dir) if r in rigs.names() and rigs.get(r).accepts_material_sets]
+        raise ConfigError("--material", set_name, f"rig {rig} takes one material, and {set_name} is a material set "
+                          f"(rigs that take sets: {', '.join(takers) or 'none'}; pycal/rigs/<rig>.py)")
     set_path = f"configs/{SET_DIR}/{set_name}.yaml"
     raw = load_yaml(Path(config_dir) / SET_DIR / f"{set_name}.yaml")
     known = {m: copy.deepcopy(load_material(m, config_dir)) for m in material_names(config_dir)}
@@ -133,9 +131,7 @@ def resolve_set_job(rig, set_name, overrides=None, seed=1, config_dir=CONFIG_DIR
         if m in known:
             validate_material(known[m], f"configs/materials/{m}.yaml (with overrides)", partners)
     mset = validate_material_set(raw, f"{set_path} (with overrides)" if overrides else set_path, known)
-    rig_checker = _Checker(f"configs/rigs/{rig}.yaml (with overrides)")
-    check_rig_keys(rig_cfg, rig_checker)
-    check_numerics_choices(rig_cfg["numerics"], rig_checker, "numerics.")
+    check_rig_with_overrides(rig, rig_cfg, overrides, config_dir)
     materials = {m: known[m] for m in mset["components"]}
     for a, pairs in mset["cross_interactions"].items():
         for b, props in pairs.items():
@@ -203,12 +199,42 @@ def check_contacts(job):
 
 
 def check_rig_geometry(job):
-    """Rig-specific checks of a job that need more than the config's keys (the transfer rig:
-    pycal.stream.check_job); a ConfigError names the rig config's key."""
-    if job["rig_config"]["script"] == "transfer.py":
-        from . import stream
-        stream.check_job(job)
+    """Rig-specific checks of a job that need more than the config's keys (the rig
+    descriptor's check_job: a particle larger than the cell, the transfer rig's stream);
+    a ConfigError names the rig config's key."""
+    desc = rigs.get(job["rig"])
+    if desc.check_job is not None:
+        desc.check_job(job)
     return job
+
+
+class blame_override:
+    """Context: a ConfigError about a key the user overrode (--set KEY=VALUE) names
+    '--set KEY=VALUE' instead of the config file (prefix 'rig.' for rig keys)."""
+
+    def __init__(self, overrides, prefix):
+        self.overrides, self.prefix = overrides or {}, prefix
+
+    def __enter__(self):
+        return self
+
+    def __exit__(self, kind, exc, tb):
+        if isinstance(exc, ConfigError):
+            key = self.prefix + exc.field
+            hits = [k for k in self.overrides if key == k or key.startswith(k + ".")]
+            if hits:
+                value = self.overrides[hits[0]]
+                raise ConfigError("--set", f"{hits[0]}={value!r}", exc.reason) from None
+        return False
+
+
+def check_rig_with_overrides(rig, rig_cfg, overrides, config_dir):
+    """The overridden rig config against its descriptor (units, types, ranges)."""
+    with blame_override(overrides, "rig."):
+        check_rig_keys(rig_cfg, _Checker(f"configs/rigs/{rig}.yaml (with overrides)"))
+        from .configs import load_numerics
+        rigs.check_config(rig_cfg, f"configs/rigs/{rig}.yaml (with overrides)",
+                          tuple(load_boundaries_cached(config_dir)), tuple(load_numerics(config_dir)))
 
 
 def canonical_json(obj):

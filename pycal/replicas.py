@@ -21,18 +21,19 @@ script runs replicas and the largest batch.
 import copy
 import math
 
+from . import rigs
 from .errors import ConfigError, RunError
 from .jobs import canonical_json, content_digest, resolve_job
 from .rig_contract import BATCH_SEEDS_KEY, LAYOUT_KEY, replica_dir_name, seed_job
 
 LAYOUTS = ("side_by_side", "sequential")
 
-# rig -> largest batch (replicas per YADE run). Not listed: the tilt-table friction rigs
+# rig -> largest batch (replicas per YADE run; replicas_max of its descriptor). Not listed: the tilt-table friction rigs
 # (gravity is rotated for the whole scene: replicas would share one tilt, and a seed's
 # hold at its own onset angle could not happen; their process cost is < 1 % of a curve)
 # aor_mixed (its time step comes from the lumps drawn: replicas would share the
 # smallest of the batch) and transfer (a periodic cell: no room for a copy beside it).
-REPLICA_RIGS = {"fill": 8, "aor": 8, "surcharge": 8, "ccs": 8, "ccs_expansion": 8, "ucs": 8}
+REPLICA_RIGS = {name: rigs.get(name).replicas_max for name in rigs.names() if rigs.get(name).replicas_max}
 
 
 def is_batch(job):

@@ -5,14 +5,15 @@ steps = longest simulated time of the rig (s) / time step (s).
 - Time step (s): what the rigs use, numerics.timestep_safety_factor x YADE's
   PWaveTimeStep, i.e. the smallest radius / sqrt(E / density) over the particle
   spheres. For clump materials the smallest member a lump of the job's size classes
-  can have (lump rule of yade_scripts/demlib/clumps.py at the class's minimum size):
+  can have (lump rule of pycal/lump_geometry.py at the class's minimum size):
   the run's own time step, set by the lumps actually drawn, is that or longer.
 - Longest simulated time (s): the sum of the rig's phases, each at its limit: a rest
   wait (settle, load step) ends after at most numerics.max_settle_time_s (plus one rest
   check interval) or the rig fails; a cylinder lift ends by its own time limit
   (1.5 x the lift height / lift speed + 1 s); a tilt test tilts to max_tilt_deg, holds,
   resumes and tilts back; the transfer rig runs its feed time and its holdup wait
-  (docs/rigs.md lists each rig's phases).
+  (docs/rigs.md lists each rig's phases; each rig's descriptor, pycal/rigs/<rig>.py,
+  states them).
 
 A job above numerics.max_estimated_steps_count is refused at job resolution with one
 line naming the values that drive the estimate (pycal.jobs.resolve_job).
@@ -29,7 +30,7 @@ DT_KEYS = ("contact.youngs_modulus_pa", "particles.density_kg_m3", "particles.di
 def _clump_member_radius(mat, class_names=None):
     """Smallest member-sphere radius (m) of a clump material over its size classes (the
     ones named, or all) and the shapes they use."""
-    from yade_scripts.demlib.clumps import box_dims, member_radius   # numpy only, no YADE
+    from .lump_geometry import box_dims, member_radius
     p = mat["particles"]
     radii = []
     for sc in p["size_classes"]:
@@ -70,73 +71,13 @@ def critical_timestep(job):
 
 # ---------------------------------------------------------------- longest simulated time per rig
 
-def _largest_size_m(job):
-    """Largest particle size (m): sphere diameter or lump size-class maximum."""
-    sizes = []
-    for mat in job["materials"].values():
-        p = mat["particles"]
-        sizes += [p["diameter_m"]] if p["shape"] == "sphere" else [sc["max_size_m"] for sc in p["size_classes"]]
-    return max(sizes)
-
-
 def _phases(job):
-    """[(phase, longest simulated time s, the config key that sets it)] of the job's rig."""
-    rig = job["rig_config"]
-    num, p, script = rig["numerics"], rig["procedure"], rig["script"]
+    """[(phase, longest simulated time s, the config key that sets it)] of the job's rig
+    (its descriptor's phases, pycal/rigs/<rig>.py)."""
+    from . import rigs
+    num = job["rig_config"]["numerics"]
     wait = num["max_settle_time_s"] + num["rest_check_interval_s"]
-    settle_key = "rig.numerics.max_settle_time_s"
-    fill = [("pour and strike (2 rest waits)", 2 * wait, settle_key)]
-
-    def lift():
-        height = p["strike_level_height_m"] + 2 * _largest_size_m(job) + p["lift_clearance_m"]
-        return [("cylinder lift", 1.5 * height / p["lift_speed_m_s"] + 1.0 + num["rest_check_interval_s"],
-                 "rig.procedure.lift_speed_m_s"),
-                ("pile settle (1 rest wait)", wait, settle_key)]
-
-    def waits(name, n, key):
-        return [(f"{name} ({n} rest waits)", n * wait, key)]
-
-    if script == "fill.py":
-        return fill
-    if script in ("aor.py", "aor_mixed.py"):
-        return fill + lift()
-    if script == "surcharge.py":
-        return fill + lift() + [("vibration", p["vibration_duration_s"], "rig.procedure.vibration_duration_s"),
-                                ("settle after vibration (1 rest wait)", wait, settle_key)]
-    if script == "ccs.py":
-        return fill + waits("load steps", len(p["load_steps_pa"]), "rig.procedure.load_steps_pa")
-    if script == "ccs_expansion.py":
-        return fill + waits("load and unload steps", len(p["load_steps_pa"]) + len(p["unload_steps_pa"]),
-                            "rig.procedure.unload_steps_pa")
-    if script == "ucs.py":
-        return fill + lift() + waits("load steps", len(p["load_steps_pa"]), "rig.procedure.load_steps_pa")
-    if script in ("wall_friction.py", "internal_friction.py"):
-        return fill + _tilt_phases(p, wait, settle_key)
-    if script == "transfer.py":          # no fill, no rest wait: the feed and the holdup wait, run to the end
-        return [("feed", p["feed_time_s"], "rig.procedure.feed_time_s"),
-                ("holdup wait after the feed", p["holdup_wait_s"], "rig.procedure.holdup_wait_s")]
-    # a rig without its own rule: its fill only (add the rule here with the rig)
-    return fill
-
-
-def _tilt_phases(p, wait, settle_key):
-    """Per consolidation step: load, unload, settle the lid (and the freed cell), the tilt
-    (static tilt to max_tilt_deg and a hold, tilting on after stalls to max_tilt_deg and
-    a hold), and the tilt back with a settle (sequential) or a new fill (fresh)."""
-    n = len(p["consolidation_stresses_pa"])
-    per_step_waits = 3 + (1 if p["settle_before_tilt"] else 0)
-    max_tilt, hold = p["max_tilt_deg"], p["dynamic_max_time_s"]
-    tilt = max_tilt / p["tilt_rate_deg_s"] + hold
-    if p["measure_dynamic_friction"]:
-        tilt += max_tilt / p["tilt_restart_rate_deg_s"] + hold
-    out = [(f"load, unload, settle ({n} steps x {per_step_waits} rest waits)", n * per_step_waits * wait, settle_key),
-           (f"tilt to {max_tilt:g} deg and hold ({n} steps)", n * tilt, "rig.procedure.tilt_rate_deg_s")]
-    if p["fill_each_step"] == "fresh":
-        out.append((f"a new fill per step ({n - 1} x 2 rest waits)", (n - 1) * 2 * wait, settle_key))
-    else:
-        out.append((f"tilt back and settle ({n} steps)", n * (max_tilt / p["tilt_return_rate_deg_s"] + wait),
-                    "rig.procedure.tilt_return_rate_deg_s"))
-    return out
+    return rigs.get(job["rig"]).phases(job, wait, "rig.numerics.max_settle_time_s")
 
 
 # ---------------------------------------------------------------- the estimate and the refusal

@@ -86,8 +86,8 @@ def contact_radius_m(job):
 
 def largest_bounding_radius_m(job):
     """Radius (m) of the largest particle's bounding sphere: a sphere's radius, a lump's
-    bounding sphere at its class's largest size (yade_scripts/demlib/clumps.py)."""
-    from yade_scripts.demlib.clumps import bounding_radius, shape_members   # numpy only, no YADE
+    bounding sphere at its class's largest size (pycal/lump_geometry.py)."""
+    from .lump_geometry import bounding_radius, shape_members
     comps = job.get("material_set", {}).get("components", {})
     out = 0.0
     for name, mat in job["materials"].items():

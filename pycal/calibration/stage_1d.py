@@ -18,14 +18,13 @@ import math
 
 import numpy as np
 
-from ..errors import RunError
+from ..errors import BudgetSpent, RunError
 from ..post import responses as responses_mod
 from ..stats import stopping
 from ..stats.scales import Scale, round_significant
 from ..stats.sequential import second_point_u, step_1d
 from . import plots
 from .names import unit_label
-from .study import BudgetSpent
 
 PROBE_GAP_U = 0.02     # bisection towards a refused point stops at this gap (fraction of the bounds)
 

@@ -21,14 +21,13 @@ import math
 
 import numpy as np
 
-from ..errors import RunError
+from ..errors import BudgetSpent, RunError
 from ..post import responses as responses_mod
 from ..stats import stopping
 from ..stats.scales import Scale, round_significant
 from ..stats.sequential import step_nd
 from . import plots
 from .names import unit_label
-from .study import BudgetSpent
 
 FIRST_STEP_U = 0.1      # a tenth of the bounds: a second pass starts from values already close
 

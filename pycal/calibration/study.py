@@ -18,7 +18,7 @@ import time
 from pathlib import Path
 
 from ..configs import load_material
-from ..errors import PycalError, RunError
+from ..errors import BudgetSpent, PycalError, RunError  # noqa: F401 (BudgetSpent: callers catch it here)
 from ..jobs import resolve_job
 from ..post import mean_std
 from ..post import responses as responses_mod
@@ -29,10 +29,6 @@ from .names import group_label, unit_of_key
 from .study_config import load_study
 
 SEED_SCHEME = "fresh seeds at every point"   # in the stage fingerprint: journals of the old scheme start afresh
-
-
-class BudgetSpent(PycalError):
-    """The study's run budget (max_runs_count) does not allow the runs asked for."""
 
 
 class Study:

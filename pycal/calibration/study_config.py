@@ -33,6 +33,7 @@ import copy
 from pathlib import Path
 
 from ..configs import _Checker, load_material, load_yaml
+from ..errors import ConfigError
 from ..post import responses as responses_mod
 from .names import group_label, unit_of_key
 
@@ -174,6 +175,36 @@ def _response(c, name, key):
     return r
 
 
+def _rig_response(c, rig, response, key):
+    """The stage's rig has a descriptor and a config, and gives `response` (a named
+    response the descriptor lists, or one of its result keys)."""
+    from .. import rigs
+    from ..configs import rig_names
+    if rig not in rig_names() or rig not in rigs.names():
+        c.fail(f"{key}.rig", f"{rig!r}: unknown rig{rigs.nearest(rig, rigs.names())} (rigs: {', '.join(rigs.names())})")
+    desc = rigs.get(rig)
+    if response.name in responses_mod.RESPONSES:
+        if response.name not in desc.responses:
+            c.fail(f"{key}.response", f"rig {rig} does not give {response.name} (it gives: "
+                   f"{', '.join(desc.responses) or 'no named response'}; pycal/rigs/{rig}.py)")
+    elif response.name not in desc.result_keys:
+        hint = rigs.nearest(response.name, desc.result_keys)
+        c.fail(f"{key}.response", f"{response.name!r} is not a result key of rig {rig}{hint} "
+               f"(its keys: {', '.join(desc.result_keys)})")
+
+
+def _lab_angle_exists(c, target, key, lab_dir):
+    """A target {sample, test} names a lab sample with that test's angles (labresults/)."""
+    if not {"sample", "test"} <= set(target):
+        return
+    from .. import LAB_DIR
+    from ..labdata import aor_target_deg
+    try:
+        aor_target_deg(target["sample"], target["test"], lab_dir or LAB_DIR)
+    except ConfigError as exc:
+        c.fail(f"{key}.sample", f"{target['sample']!r} / {target['test']!r}: {exc}")
+
+
 def _check_overrides(c, st, key, material=None, mat_cfg=None):
     """rig_overrides only rig keys; `set` only existing material keys (applied to mat_cfg,
     the material as the study has changed it so far)."""
@@ -208,6 +239,8 @@ def _one_d(c, st, key, material, mat_cfg, seeds):
            ["name", "response", "target", "rig_overrides", "run_at", "set", "max_runs_count", "lab_dir"])
     _check_overrides(c, st, key, material, mat_cfg)
     response = _response(c, st.get("response", "bulk_density_kg_m3"), f"{key}.response")
+    _rig_response(c, st["rig"], response, key)
+    _lab_angle_exists(c, st.get("target") or {}, f"{key}.target", st.get("lab_dir"))
     if response.vector:
         c.fail(f"{key}.response", f"{response.name} is a vector (one value per lab step): a joint stage's response")
     out = {"kind": kind, "label": stage_label(st), "rig": st["rig"], "response": response.name,
@@ -234,6 +267,8 @@ def _joint(c, st, key, material, mat_cfg, seeds):
         c.keys(r, rk, ["rig", "response"], ["target", "rig_overrides"])
         _check_overrides(c, r, rk)
         response = _response(c, r["response"], f"{rk}.response")
+        _rig_response(c, r["rig"], response, rk)
+        _lab_angle_exists(c, r.get("target") or {}, f"{rk}.target", st.get("lab_dir"))
         target = dict(r.get("target") or ({"value": 0.0, "band_z": 1.0} if response.unit == "z" else {}))
         resp.append({"rig": r["rig"], "response": response.name,
                      "target": _target(c, target, f"{rk}.target", response),
@@ -284,6 +319,9 @@ def load_study(path):
     out = copy.deepcopy(data)
     done = set()
     for mat, stages in data["materials"].items():
+        from ..configs import material_names
+        if mat not in material_names():
+            c.fail(f"materials.{mat}", f"unknown material {mat!r} (configs/materials: {', '.join(material_names())})")
         mat_cfg = copy.deepcopy(load_material(mat))
         if not isinstance(stages, list):
             c.fail(f"materials.{mat}", "must be a list of stages")

@@ -5,7 +5,9 @@
     runs/<rig>/.<job_id>.tmp-<host>-<pid>/        a run in progress (renamed to <job_id>/ when complete)
     runs/<rig>/<job_id>.failed/                   last failed attempt, kept for its log (never a result)
 
-A job folder with result.json is complete and never run again. A job folder without it
+A job folder with result.json is complete and never run again, if that result is the
+job's own and whole (result_problem); a result that is not is moved to
+runs/quarantine/<rig>/ with a warning and the job runs again. A job folder without it
 (written by `pycal job --write` or `pycal batch-table`, then run by hand or by yade-batch)
 is not a result: it is run again, unless the rig refused the job there (rig_failure.txt).
 A rig refusal is the physics' verdict on the job (same job, same seed: same failure) and
@@ -47,15 +49,76 @@ def job_dir(job, runs_dir):
 
 
 def failed_dir(job, runs_dir):
-    return Path(str(job_dir(job, runs_dir)) + ".failed")
+    return failed_dir_of(job_dir(job, runs_dir))
+
+
+def failed_dir_of(final):
+    return Path(str(final) + ".failed")
+
+
+def result_problem(result, job):
+    """Why a parsed result.json is not `job`'s whole result, or None: it must be a JSON
+    object, name the job's id, hold the job itself (the same content hash) and every key
+    the rig's descriptor requires (pycal/rigs/<rig>.py; a batch: its replicas)."""
+    from .. import rigs
+    from ..jobs import content_digest
+    from ..rig_contract import BATCH_SEEDS_KEY
+    if not isinstance(result, dict):
+        return "not a JSON object"
+    if result.get("job_id") != job["job_id"]:
+        return f"it is the result of job {result.get('job_id')!r}, not of {job['job_id']}"
+    if not isinstance(result.get("job"), dict) or content_digest(result["job"]) != content_digest(job):
+        return "the job it holds is not this folder's job (content hash differs)"
+    if BATCH_SEEDS_KEY in job:
+        needed = ("rig", "provenance", "replicas")
+    else:
+        needed = rigs.get(job["rig"]).required_result_keys()
+    missing = [k for k in needed if k not in result]
+    if missing:
+        return f"incomplete (no {', '.join(missing)})"
+    return None
+
+
+def quarantine(folder, runs_dir, why):
+    """Move a job folder whose result cannot be trusted to runs/quarantine/<rig>/ (kept for
+    a look, never read as a result) and print one warning line naming the file."""
+    import sys
+    stamp = time.strftime("%Y%m%dT%H%M%SZ", time.gmtime())
+    dest = Path(runs_dir) / "quarantine" / folder.parent.name / f"{folder.name}-{stamp}-{os.getpid()}"
+    dest.parent.mkdir(parents=True, exist_ok=True)
+    os.replace(folder, dest)
+    print(f"warning: {folder / RESULT_FILE}: {why}; moved to {dest}; the job runs again", file=sys.stderr,
+          flush=True)
+    return dest
 
 
 def cached_result(job, runs_dir):
-    """The result of a complete job, or None."""
-    path = job_dir(job, runs_dir) / RESULT_FILE
-    if path.is_file():
-        return json.loads(path.read_text())
+    """The result of a complete job, or None. A result.json that is not the job's whole
+    result (result_problem: unreadable, another job's, incomplete) is quarantined and the
+    job counts as not run."""
+    folder = job_dir(job, runs_dir)
+    path = folder / RESULT_FILE
+    if not path.is_file():
+        return None
+    try:
+        result = json.loads(path.read_text())
+    except (ValueError, UnicodeDecodeError) as exc:
+        why = f"not valid JSON ({exc})"
+    else:
+        why = result_problem(result, job)
+        if why is None:
+            return result
+    quarantine(folder, runs_dir, why)
     return None
+
+
+def job_file_is(folder, job):
+    """True when folder/job.json holds exactly `job` (a job file by hand or a garbage one: False)."""
+    from ..jobs import canonical_json
+    try:
+        return canonical_json(json.loads((Path(folder) / JOB_FILE).read_text())) == canonical_json(job)
+    except (OSError, ValueError, UnicodeDecodeError, TypeError):
+        return False
 
 
 def cached_failure(job, runs_dir):
@@ -89,12 +152,12 @@ def prepare_temp(job, runs_dir):
 def create_job_folder(job, runs_dir):
     """The final job folder with job.json, for a run by hand or by yade-batch (the rig
     writes result.json there last). Created whole (through a temporary rename) or kept
-    as it is when it exists. Returns its path."""
+    as it is when its job.json is the job's (else replaced). Returns its path."""
     final = job_dir(job, runs_dir)
-    if (final / JOB_FILE).is_file():
+    if (final / JOB_FILE).is_file() and job_file_is(final, job):
         return final
     tmp, _ = prepare_temp(job, runs_dir)
-    if final.exists():                 # an empty or broken folder: replace it
+    if final.exists():                 # an empty or broken folder, or a job file not the job's: replace it
         shutil.rmtree(final)
     os.replace(tmp, final)
     return final
@@ -114,6 +177,7 @@ def finish(tmp, final, log_tail):
                 shutil.rmtree(old, ignore_errors=True)
             else:
                 os.replace(tmp, final)
+        shutil.rmtree(failed_dir_of(final), ignore_errors=True)   # an earlier failed attempt: done now
         return json.loads((final / RESULT_FILE).read_text())
     failed = final.parent / f"{final.name}.failed"
     if failed.exists():

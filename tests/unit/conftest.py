@@ -1,6 +1,7 @@
 """Fixtures of the unit layer."""
 import shutil
 import stat
+from pathlib import Path
 
 import pytest
 
@@ -15,6 +16,7 @@ def cfg(tmp_path):
     return dst
 
 
+FAKE_RESULT = Path(__file__).with_name("fake_result.py")
 FAKE_YADE = """#!/bin/sh
 # fake yade: args are -j1 -x -n SCRIPT JOB; behaviour chosen by $FAKE_MODE
 job="$5"
@@ -22,15 +24,15 @@ job="$5"
 echo "fake yade running $4 $job"
 echo run >> "$FAKE_COUNT"
 case "$FAKE_MODE" in
-  ok) echo '{"bulk_density_kg_m3": 1600.0, "n_particles": 100}' > result.json ;;
+  ok) /usr/bin/python3 FAKE_RESULT "$job" '{"bulk_density_kg_m3": 1600.0, "n_particles": 100}' ;;
   fail) echo "RIG FAILED: blow-up: particle 7 left the rig domain"; exit 3 ;;
   refuse) echo "RIG FAILED: pile settle: no rest after 8 s" | tee rig_failure.txt; exit 3 ;;
   partial) echo '{"bulk' > result.json.part; exit 4 ;;
   sleep) sleep 5 ;;
-  sleep_then_ok) sleep 2; echo '{"bulk_density_kg_m3": 1600.0, "n_particles": 100}' > result.json ;;
+  sleep_then_ok) sleep 2; /usr/bin/python3 FAKE_RESULT "$job" '{"bulk_density_kg_m3": 1600.0, "n_particles": 100}' ;;
   spin) while :; do :; done ;;
 esac
-"""
+""".replace("FAKE_RESULT", str(FAKE_RESULT))
 
 
 def install_fake_yade(tmp_path, monkeypatch, script):

@@ -67,7 +67,7 @@ def test_contact_model_changes_the_job_id():
 
 
 def test_unknown_contact_model_is_refused():
-    with pytest.raises(ConfigError, match=r"configs/rigs/fill.yaml \(with overrides\): numerics.contact_model: "
+    with pytest.raises(ConfigError, match=r"--set: rig.numerics.contact_model='dem': "
                                           r"'dem' must be one of hertz_mindlin, linear_cundall"):
         resolve_job("fill", "M2", {"rig.numerics.contact_model": "dem"})
 
@@ -94,7 +94,7 @@ def test_first_law_has_no_linear_cohesion():
 
 
 def test_liquid_bridge_with_rolling_resistance_names_the_pair():
-    bridge = {"model": "liquid_bridge", "surface_tension_n_m": 1.8, "contact_angle_deg": 0.0,
+    bridge = {"model": "liquid_bridge", "surface_tension_n_m": 0.072, "contact_angle_deg": 0.0,
               "bridge_liquid_fraction": 0.1, "coordination_count": 6.0}
     others = {f"interactions.{p}.cohesion": {"model": "none"} for p in ("M1", "M2", "M3-dry", "steel", "pvc")}
     with pytest.raises(ConfigError, match=r"configs/materials/M3-wet.yaml: interactions.M3-wet.rolling_resistance_"
@@ -104,7 +104,7 @@ def test_liquid_bridge_with_rolling_resistance_names_the_pair():
 
 
 def test_liquid_bridge_with_another_cohesion_names_the_pair():
-    bridge = {"model": "liquid_bridge", "surface_tension_n_m": 1.8, "contact_angle_deg": 0.0,
+    bridge = {"model": "liquid_bridge", "surface_tension_n_m": 0.072, "contact_angle_deg": 0.0,
               "bridge_liquid_fraction": 0.1, "coordination_count": 6.0}
     with pytest.raises(ConfigError, match=r"configs/materials/M3-wet.yaml: interactions.steel.cohesion.model: "
                                           r"'force_fraction' cannot be combined with the viscoelastic_capillary law"):

@@ -34,7 +34,7 @@ def test_overrides_apply_to_material_and_rig():
 
 
 def test_bad_override_is_validated():
-    with pytest.raises(ConfigError, match=r"particles.density_kg_m3: -5 must be > 0"):
+    with pytest.raises(ConfigError, match=r"--set: particles.density_kg_m3=-5: -5 must be > 0"):
         resolve_job("fill", "M2", {"particles.density_kg_m3": -5})
     with pytest.raises(ConfigError, match=r"no such key to override"):
         resolve_job("fill", "M2", {"particles.colour": "red"})

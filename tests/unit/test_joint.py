@@ -145,7 +145,7 @@ def test_a_refused_point_is_not_asked_again_and_the_fit_goes_on(tmp_path):
 
 @pytest.mark.parametrize("old, new, message", [
     ("response: friction_band_z_mu_static}", "response: aor_mean_deg}",
-     r"materials.M3-wet\[0\].responses\[0\].target: needs value"),
+     r"materials.M3-wet\[0\].responses\[0\].response: rig wall_friction does not give aor_mean_deg"),
     ("        - {keys: [interactions.steel.cohesion.pressure_fraction], start: 0.005, bounds: [0.0, 0.05],\n"
      "           tolerance_fraction: 0.004}\n", "",
      r"materials.M3-wet\[0\].parameters: a joint stage moves a list of 2 or 3 parameter groups"),

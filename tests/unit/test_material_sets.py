@@ -72,8 +72,8 @@ def test_set_overrides_reach_component_set_and_rig():
 
 
 def test_rig_for_one_material_rejects_a_set():
-    with pytest.raises(ConfigError, match=r"configs/rigs/aor.yaml: accepts_material_sets: rig aor takes one "
-                                          r"material, and mixed-dry is a material set \(rigs that take sets: aor_mixed, transfer\)"):
+    with pytest.raises(ConfigError, match=r"--material: mixed-dry: rig aor takes one "
+                                          r"material, and mixed-dry is a material set \(rigs that take sets: aor_mixed, transfer;"):
         resolve_job("aor", "mixed-dry")
 
 

@@ -37,7 +37,8 @@ if "seeds" in job:
     result = dict(common, seeds=job["seeds"], replicas=rows, replicas_count=len(rows),
                   replicas_failed_count=sum(r["status"] != "ok" for r in rows), replica_spacing_m=1.0)
 else:
-    result = dict(common, seed=job["seed"], bulk_density_kg_m3=1000.0 + job["seed"])
+    result = dict(common, seed=job["seed"], bulk_density_kg_m3=1000.0 + job["seed"], mass_kg=1.0, n_particles=9,
+                  solid_fraction=0.4, timestep_s=1e-5)
 json.dump(result, open("result.json", "w"))
 """
 

@@ -133,7 +133,7 @@ def test_cli_bad_override_exit_2(tmp_path, capsys):
     rc = main(["run", "fill", "--material", "M2", "--set", "particles.density_kg_m3=-5",
                "--out", str(tmp_path / "runs")])
     assert rc == 2
-    assert "particles.density_kg_m3: -5 must be > 0" in capsys.readouterr().err
+    assert "--set: particles.density_kg_m3=-5: -5 must be > 0" in capsys.readouterr().err
     assert not (tmp_path / "runs").exists()
 
 

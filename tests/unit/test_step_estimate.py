@@ -66,10 +66,10 @@ def test_the_calibration_bounds_run():
 
 def test_a_far_too_stiff_particle_is_refused_naming_the_value():
     with pytest.raises(ConfigError) as exc:
-        resolve_job("fill", "M2", {"contact.youngs_modulus_pa": 1.0e15})
+        resolve_job("fill", "M2", {"contact.youngs_modulus_pa": 1.0e12, "particles.diameter_m": 0.001})
     msg = str(exc.value)
-    assert msg.startswith("--set: contact.youngs_modulus_pa=1e+15: fill with M2 would take up to 1.55e+09 time steps")
-    assert "max_estimated_steps_count 1e+08" in msg and "time step 1.04e-08 s" in msg
+    assert msg.startswith("--set: contact.youngs_modulus_pa=1e+12: fill with M2 would take up to 1.22e+09 time steps")
+    assert "max_estimated_steps_count 1e+08" in msg and "time step 1.31e-08 s" in msg
 
 
 def test_a_far_too_slow_lift_is_refused_naming_the_lift_speed():
@@ -80,25 +80,26 @@ def test_a_far_too_slow_lift_is_refused_naming_the_lift_speed():
 
 
 def test_the_limit_can_be_raised_for_one_job():
-    job = resolve_job("fill", "M2", {"contact.youngs_modulus_pa": 1.0e15,
+    job = resolve_job("fill", "M2", {"contact.youngs_modulus_pa": 1.0e12, "particles.diameter_m": 0.001,
                                      "rig.numerics.max_estimated_steps_count": 1.0e10})
-    assert se.estimate(job)["steps_count"] == pytest.approx(1.548e9, rel=1e-2)
+    assert se.estimate(job)["steps_count"] == pytest.approx(1.22e9, rel=1e-2)
 
 
 def test_a_stiff_material_config_is_refused_naming_the_limit(cfg):
-    edit(cfg / "materials" / "M2.yaml", "youngs_modulus_pa: 2.0e7", "youngs_modulus_pa: 1.0e15")
+    edit(cfg / "materials" / "M2.yaml", "youngs_modulus_pa: 2.0e7", "youngs_modulus_pa: 1.0e12")
+    edit(cfg / "materials" / "M2.yaml", "diameter_m: 0.025", "diameter_m: 0.001")
     with pytest.raises(ConfigError) as exc:
         resolve_job("fill", "M2", config_dir=cfg)
     assert str(exc.value).startswith("configs/numerics.yaml: max_estimated_steps_count: fill with M2")
-    assert "contact.youngs_modulus_pa 1e+15" in str(exc.value)
+    assert "contact.youngs_modulus_pa 1e+12" in str(exc.value)
 
 
 def test_cli_refusal_is_one_line_exit_2_and_writes_nothing(tmp_path, capsys):
     out = tmp_path / "runs"
-    assert main(["run", "fill", "--material", "M2", "--set", "contact.youngs_modulus_pa=1e15",
-                 "--out", str(out)]) == 2
+    assert main(["run", "fill", "--material", "M2", "--set", "contact.youngs_modulus_pa=1e12",
+                 "--set", "particles.diameter_m=0.001", "--out", str(out)]) == 2
     err = capsys.readouterr().err.strip().splitlines()
-    assert len(err) == 1 and err[0].startswith("error: --set: contact.youngs_modulus_pa=1e+15:")
+    assert len(err) == 1 and err[0].startswith("error: --set: contact.youngs_modulus_pa=1e+12:")
     assert not out.exists()
 
 

@@ -327,7 +327,18 @@ def test_shipped_study_config_is_valid():
         assert labels.index("wall_friction") < labels.index("rolling_density_final")
 
 
-def test_stiffness_stage_works_in_log_e(tmp_path):
+@pytest.fixture
+def fake_stiffness_key(monkeypatch):
+    """The fake ccs_expansion (fake_rigs.stiffness_result) writes stiffness_log_ratio, a key
+    the real rig does not: its descriptor lists it for these tests."""
+    import dataclasses
+    from pycal import rigs
+    desc = rigs.get("ccs_expansion")
+    monkeypatch.setitem(rigs._REGISTRY, "ccs_expansion",
+                        dataclasses.replace(desc, result_keys=desc.result_keys + ("stiffness_log_ratio",)))
+
+
+def test_stiffness_stage_works_in_log_e(tmp_path, fake_stiffness_key):
     """log(sim / lab) = log(0.17 E / 6e6): the lab is matched at E = 3.53e7 Pa."""
     cfg = tmp_path / "stiff.yaml"
     cfg.write_text("""
@@ -354,7 +365,7 @@ materials:
     assert es[2] == pytest.approx(6e6 * (1e9 / 1e6) ** 0.25, rel=1e-3)
 
 
-def test_a_point_the_rig_refuses_becomes_a_limit(tmp_path):
+def test_a_point_the_rig_refuses_becomes_a_limit(tmp_path, fake_stiffness_key):
     """The servo cannot hold its load above 3e8 Pa (measured on M3-dry at 4.68e8): the
     stage must not ask again beyond halfway back, and still land on the root 2e8."""
     cfg = tmp_path / "stiff.yaml"

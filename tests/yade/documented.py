@@ -1,8 +1,9 @@
 """Every result.json key of a rig is documented in docs/rigs.md (its section or the
-shared one): a rig that adds a key without documenting it fails its physics test."""
+shared one), and holds the keys its descriptor requires (pycal/rigs/<rig>.py): a rig
+that adds a key without documenting it, or drops a required one, fails its physics test."""
 import re
 
-from pycal import REPO_ROOT
+from pycal import REPO_ROOT, rigs
 
 # sections whose keys a rig's result also carries (docs/rigs.md: "every key of ...")
 INHERITS = {"surcharge": ["aor"], "aor_mixed": ["aor"], "ccs_expansion": ["ccs"], "ucs": ["ccs"],
@@ -44,5 +45,10 @@ def undocumented(result):
 
 
 def assert_documented(result):
+    """Every key documented, and every key the rig's descriptor requires of a whole result
+    (pycal/rigs/<rig>.py: the cache trusts a result only with them) present."""
     missing = undocumented(result)
     assert not missing, f"{result['rig']}: result.json keys not in docs/rigs.md: {', '.join(missing)}"
+    if "replicas" not in result:
+        absent = [k for k in rigs.get(result["rig"]).required_result_keys() if k not in result]
+        assert not absent, f"{result['rig']}: result.json lacks the descriptor's keys {', '.join(absent)}"

@@ -16,12 +16,13 @@ import traceback
 
 _T0 = time.time()
 _STARTED = datetime.datetime.now(datetime.timezone.utc).isoformat(timespec="seconds")
-_JOB_DIR = None       # folder of the job file being run (load_job), where every output goes
 
 
 from pycal.contact_rules import law_of_job
 from pycal.rig_contract import (RESULT_FILE, RIG_FAILURE_FILE, EXIT_RIG_FAILURE, EXIT_ERROR, EXIT_OK,
                                 BATCH_SEEDS_KEY)
+
+from . import job_folder as job_folder_state
 
 
 class RigFailure(Exception):
@@ -73,7 +74,6 @@ def job_path_from_argv():
 
 def load_job():
     """(job dict, output folder)."""
-    global _JOB_DIR
     path = os.path.abspath(job_path_from_argv())
     try:
         with open(path) as f:
@@ -84,14 +84,14 @@ def load_job():
         raise JobFileError(f"job file {path}: not valid JSON ({exc})") from None
     if not isinstance(job, dict):
         raise JobFileError(f"job file {path}: not a job (a JSON object is expected)")
-    _JOB_DIR = os.path.dirname(path)
-    return job, _JOB_DIR
+    job_folder_state.set_folder(os.path.dirname(path))
+    return job, job_folder_state.get()
 
 
 def job_folder():
     """The folder of the job being run (the current directory if no job file was loaded:
     test scenes)."""
-    return _JOB_DIR or os.getcwd()
+    return job_folder_state.get()
 
 
 def provenance():

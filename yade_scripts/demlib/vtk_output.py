@@ -28,8 +28,8 @@ _STATE = {"job": None, "scene": 0, "time_offset_s": 0.0, "recorder": None, "pref
 
 
 def _folder(job):
-    from . import jobio
-    return os.path.join(jobio.job_folder(), job["vtk"]["folder"])
+    from . import job_folder
+    return os.path.join(job_folder.get(), job["vtk"]["folder"])
 
 
 def begin_scene(job):

@@ -1,0 +1,18 @@
+"""ccs_expansion: CCS with unloading (calibrates the particle stiffness)."""
+from ._cells import CELL, COMPRESSION_RESULT, POUR, SERVO
+from .descriptor import RigDescriptor, fill_phases, particle_fits_cell, waits
+
+
+def phases(job, wait, settle_key):
+    p = job["rig_config"]["procedure"]
+    n = len(p["load_steps_pa"]) + len(p["unload_steps_pa"])
+    return fill_phases(job, wait, settle_key) + waits("load and unload steps", n, "rig.procedure.unload_steps_pa",
+                                                      wait)
+
+
+DESCRIPTOR = RigDescriptor(
+    name="ccs_expansion", script="ccs_expansion.py",
+    geometry=CELL + ("table_material", "plate_material"),
+    procedure=POUR + ("load_steps_pa", "unload_steps_pa") + SERVO,
+    phases=phases, result_keys=COMPRESSION_RESULT + ("unloading_stiffness_pa", "unloading_stress_pa"),
+    responses=("unloading_stiffness_log_ratio",), replicas_max=8, check_job=particle_fits_cell)
