@@ -25,7 +25,8 @@ RANGES = {
     "pressure_fraction": (0.0, 10.0, "pull-off / largest compressive force the contact carried"),
     "stiffness_fraction": (0.0, 1.0, "pull-off / the largest elastic force of the contact"),
     "adhesive_distance_m": (0.0, 0.1, "an adhesion reach of at most 0.1 m"),
-    "surface_tension_n_m": (0.0, 1.0, "water is 0.072 N/m, mercury 0.49 N/m"),
+    "surface_tension_n_m": (0.0, 100.0, "an effective value: coarse spheres standing for fines carry more than "
+                            "water's 0.072 N/m (one bridge holds a 25 mm ore sphere from 2.8 N/m on)"),
 }
 
 

@@ -94,7 +94,7 @@ def test_first_law_has_no_linear_cohesion():
 
 
 def test_liquid_bridge_with_rolling_resistance_names_the_pair():
-    bridge = {"model": "liquid_bridge", "surface_tension_n_m": 0.072, "contact_angle_deg": 0.0,
+    bridge = {"model": "liquid_bridge", "surface_tension_n_m": 1.8, "contact_angle_deg": 0.0,
               "bridge_liquid_fraction": 0.1, "coordination_count": 6.0}
     others = {f"interactions.{p}.cohesion": {"model": "none"} for p in ("M1", "M2", "M3-dry", "steel", "pvc")}
     with pytest.raises(ConfigError, match=r"configs/materials/M3-wet.yaml: interactions.M3-wet.rolling_resistance_"
@@ -104,7 +104,7 @@ def test_liquid_bridge_with_rolling_resistance_names_the_pair():
 
 
 def test_liquid_bridge_with_another_cohesion_names_the_pair():
-    bridge = {"model": "liquid_bridge", "surface_tension_n_m": 0.072, "contact_angle_deg": 0.0,
+    bridge = {"model": "liquid_bridge", "surface_tension_n_m": 1.8, "contact_angle_deg": 0.0,
               "bridge_liquid_fraction": 0.1, "coordination_count": 6.0}
     with pytest.raises(ConfigError, match=r"configs/materials/M3-wet.yaml: interactions.steel.cohesion.model: "
                                           r"'force_fraction' cannot be combined with the viscoelastic_capillary law"):
