@@ -113,20 +113,6 @@ def derived_arrays(result):
 
 # ------------------------------------------------------------------ lab comparison
 
-# which simulated array is compared with which lab column, per rig:
-# (name of the misfit, simulated key, lab quantity, factor applied to the lab values, branch)
-COMPARISONS = {
-    "ccs": [("bulk_stiffness", "stiffness_pa", "bulk_stiffness_pa", None, "loading"),
-            ("solid_fraction", "solid_fraction", "solid_fraction", None, "loading"),
-            ("bulk_density", "bulk_density_kg_m3", "solid_fraction", "lab_particle_density", "loading")],
-    "ucs": [("bulk_stiffness", "stiffness_pa", "bulk_stiffness_pa", None, "loading"),
-            ("bulk_density", "bulk_density_kg_m3", "bulk_density_kg_m3", None, "loading")],
-    "ccs_expansion": [("unloading_stiffness", "stiffness_pa", "particle_stiffness_pa", None, "unloading"),
-                      ("bulk_stiffness", "stiffness_pa", "bulk_stiffness_pa", None, "loading"),
-                      ("solid_fraction", "solid_fraction", "solid_fraction", None, "loading")],
-}
-
-
 def lab_curve_name(rig, lab_sample):
     return f"{rig}_{lab_sample}"
 
@@ -134,12 +120,11 @@ def lab_curve_name(rig, lab_sample):
 def load_targets(rig, lab_sample, lab_dir=None):
     """Targets (pycal.post.lab_curves form) of the lab curve <rig>_<lab_sample>, plus
     '_particle_density' (kg/m3, labresults/samples.yaml: lab solid fractions become bulk
-    densities); for ccs_expansion the loading-branch quantities come from the ccs curve
-    of the sample. {} when there is no such curve."""
+    densities); the curves are those the rig's descriptor names (pycal/rigs/<rig>.py:
+    ccs_expansion's loading branch is the sample's ccs curve). {} when there is none."""
     from .. import labdata
-    names = [lab_curve_name(rig, lab_sample)]
-    if rig == "ccs_expansion":
-        names.append(lab_curve_name("ccs", lab_sample))
+    from .. import rigs
+    names = [lab_curve_name(r, lab_sample) for r in rigs.get(rig).lab_curves]
     out = lab_curves.load_targets(names, lab_dir)
     if out:
         kw = {} if lab_dir is None else {"lab_dir": lab_dir}
@@ -154,7 +139,8 @@ def compare(result, targets):
     if not targets:
         return out
     branch = result.get("branch") or ["loading"] * len(result["stress_pa"])
-    for name, key, quantity, factor, br in COMPARISONS.get(result["rig"], []):
+    from .. import rigs
+    for name, key, quantity, factor, br in rigs.get(result["rig"]).comparisons:
         if quantity not in targets or key not in result:
             continue
         t = targets[quantity]

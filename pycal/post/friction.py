@@ -38,7 +38,10 @@ def dynamic_value(result, k):
     a = (result.get("dynamic_angle_deg") or [None] * (k + 1))[k]
     v = result["mu_dynamic"][k]
     return None if v is None or (a is not None and a > DYNAMIC_MAX_ANGLE_DEG) else v
-RIGS = ("wall_friction", "internal_friction")
+def friction_rigs():
+    """The tilt-table rigs (post: friction in their descriptors, pycal/rigs/)."""
+    from .. import rigs
+    return tuple(n for n in rigs.names() if rigs.get(n).post == "friction")
 
 
 # ------------------------------------------------------------------ statistics
@@ -301,7 +304,7 @@ def write_outputs(results, out_dir, lab_dir=None, targets=None, plots=True):
     loaded = [read_result(r) if isinstance(r, (str, os.PathLike)) else r
               for r in (results if isinstance(results, (list, tuple)) else [results])]
     rigs = {r["rig"] for r in loaded}
-    if len(rigs) != 1 or not rigs <= set(RIGS):
+    if len(rigs) != 1 or not rigs <= set(friction_rigs()):
         raise ValueError(f"write_outputs: results of one friction rig expected, got {sorted(rigs)}")
     rig = rigs.pop()
     summary = seed_summary(loaded)
@@ -325,8 +328,8 @@ def write_outputs(results, out_dir, lab_dir=None, targets=None, plots=True):
 def _cli_handle(loaded, out_dir):
     from ..errors import ConfigError
     rigs = {r["rig"] for _, r in loaded}
-    if len(rigs) != 1 or not rigs <= set(RIGS):
-        raise ConfigError(loaded[0][0], "rig", f"results of one friction rig ({', '.join(RIGS)}) expected, "
+    if len(rigs) != 1 or not rigs <= set(friction_rigs()):
+        raise ConfigError(loaded[0][0], "rig", f"results of one friction rig ({', '.join(friction_rigs())}) expected, "
                                                f"got {', '.join(sorted(rigs))}")
     res = write_outputs([r for _, r in loaded], out_dir or os.path.dirname(os.path.abspath(loaded[0][0])))
     for f in res["files"]:

@@ -17,3 +17,7 @@ COMPRESSION_RESULT = ("stress_pa", "strain", "bulk_density_kg_m3", "n_particles"
 FRICTION_RESULT = ("steps", "stress_pa", "mu_static", "mu_dynamic", "n_particles")
 FRICTION_RESPONSES = ("friction_offset_mu_static", "friction_offset_mu_dynamic", "friction_angle_offset_deg",
                       "friction_band_z_mu_static", "friction_band_z_mu_dynamic")
+
+# compression misfits: (name of the misfit, simulated key, lab quantity, factor applied to the lab values, branch)
+LOADING_COMPARISONS = (("bulk_stiffness", "stiffness_pa", "bulk_stiffness_pa", None, "loading"),
+                       ("solid_fraction", "solid_fraction", "solid_fraction", None, "loading"))

@@ -1,5 +1,5 @@
 """ccs_expansion: CCS with unloading (calibrates the particle stiffness)."""
-from ._cells import CELL, COMPRESSION_RESULT, POUR, SERVO
+from ._cells import CELL, COMPRESSION_RESULT, LOADING_COMPARISONS, POUR, SERVO
 from .descriptor import RigDescriptor, fill_phases, particle_fits_cell, waits
 
 
@@ -15,4 +15,7 @@ DESCRIPTOR = RigDescriptor(
     geometry=CELL + ("table_material", "plate_material"),
     procedure=POUR + ("load_steps_pa", "unload_steps_pa") + SERVO,
     phases=phases, result_keys=COMPRESSION_RESULT + ("unloading_stiffness_pa", "unloading_stress_pa"),
-    responses=("unloading_stiffness_log_ratio",), replicas_max=8, check_job=particle_fits_cell)
+    responses=("unloading_stiffness_log_ratio",), replicas_max=8, check_job=particle_fits_cell,
+    post="compression", lab_curves=("ccs_expansion", "ccs"),   # the loading branch: the sample's ccs curve
+    comparisons=(("unloading_stiffness", "stiffness_pa", "particle_stiffness_pa", None, "unloading"),)
+    + LOADING_COMPARISONS)

@@ -4,9 +4,10 @@ It names the rig's config keys (checked against pycal/rigs/fields.py), its phase
 the step estimate (pycal.step_estimate), how many replicas one YADE run may hold
 (pycal.replicas), the result keys a complete result.json must hold (the cache trusts a
 result only with them; docs/rigs.md documents them), the responses a study stage may
-read from it, and any check that needs the whole job (a particle larger than the cell).
+read from it, its post-processing (module, lab curves, misfits) and any check that
+needs the whole job (a particle larger than the cell).
 """
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 from typing import Callable, Optional
 
 # every result.json holds these (docs/rigs.md "What every rig shares")
@@ -27,7 +28,9 @@ class RigDescriptor:
     replicas_max: int = 0                           # 0: no replicas (one seed per YADE run)
     accepts_material_sets: bool = False
     check_job: Optional[Callable] = None            # (job) -> None or raises ConfigError
-    extra: dict = field(default_factory=dict)
+    post: str = ""                                  # its post-processing module (pycal/post/<post>.py)
+    lab_curves: tuple = ()                          # rigs whose lab curves <rig>_<sample> it is compared with
+    comparisons: tuple = ()                         # (misfit, result key, lab quantity, lab factor, branch)
 
     def keys(self, section):
         return tuple(getattr(self, section)) + tuple(k.split(".", 1)[1] for k in self.optional

@@ -18,4 +18,5 @@ DESCRIPTOR = RigDescriptor(
     name="surcharge", script="surcharge.py",
     geometry=CELL + ("table_material", "table_radius_m"), procedure=POUR + LIFT + VIBRATION, measure=PILE_READING,
     phases=phases, result_keys=AOR_RESULT + ("surcharge_mean_deg", "surcharge_sectors_count"),
-    responses=("aor_mean_deg", "surcharge_mean_deg"), replicas_max=8, check_job=particle_fits_cell)
+    responses=("aor_mean_deg", "surcharge_mean_deg"), replicas_max=8, check_job=particle_fits_cell,
+    post="aor")

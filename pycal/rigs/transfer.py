@@ -24,4 +24,4 @@ DESCRIPTOR = RigDescriptor(
     measure=("steady_from_s", "plug_outflow_ratio", "record_interval_s", "force_sample_interval_count",
              "speed_gauge_height_m", "stress_profile_bin_m", "frame_interval_s"),
     phases=phases, result_keys=("impact_stress_pa", "throughput_in_kg_s", "throughput_out_kg_s"),
-    accepts_material_sets=True, check_job=check_job)
+    accepts_material_sets=True, check_job=check_job, post="transfer")

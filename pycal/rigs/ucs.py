@@ -14,4 +14,6 @@ DESCRIPTOR = RigDescriptor(
     geometry=CELL + ("table_material", "plate_material", "table_radius_m", "plate_diameter_m"),
     procedure=POUR + LIFT + ("load_steps_pa",) + SERVO,
     phases=phases, result_keys=("stress_pa", "strain", "n_particles"), replicas_max=8,
-    check_job=particle_fits_cell)
+    check_job=particle_fits_cell, post="compression", lab_curves=("ucs",),
+    comparisons=(("bulk_stiffness", "stiffness_pa", "bulk_stiffness_pa", None, "loading"),
+                 ("bulk_density", "bulk_density_kg_m3", "bulk_density_kg_m3", None, "loading")))

@@ -58,3 +58,22 @@ def test_the_load_step_failure_is_in_troubleshooting():
     src = (REPO_ROOT / "yade_scripts" / "demlib" / "loading.py").read_text()
     assert "not reached at rest after" in src
     assert "not reached at rest after" in _squash((DOCS / "troubleshooting.md").read_text())
+
+
+def test_every_rig_has_a_descriptor_and_its_result_keys_are_documented():
+    """A rig config without a descriptor, or a descriptor's result key that docs/rigs.md
+    does not name (the yade layer checks that real results hold them)."""
+    import sys
+    from pycal import REPO_ROOT, rigs
+    from pycal.configs import rig_names
+    sys.path.insert(0, str(REPO_ROOT / "tests" / "yade"))
+    from documented import documented_keys
+    assert set(rig_names()) == set(rigs.names())
+    for name in rigs.names():
+        desc = rigs.get(name)
+        assert (REPO_ROOT / "yade_scripts" / desc.script).is_file(), desc.script
+        names = documented_keys(name)
+        missing = [k for k in desc.required_result_keys()
+                   if k not in names and "." + k not in names and not any(n.startswith(k + ".") for n in names)]
+        assert not missing, (name, missing)
+        assert not desc.post or (REPO_ROOT / "pycal" / "post" / f"{desc.post}.py").is_file(), desc.post
