@@ -50,8 +50,10 @@ def headline(stages):
     """'3 of 5 calibrated stages met ...' and the stages not met (inherited values apart)."""
     calibrated = [s for s in stages if s["kind"] != "inherit"]
     met = [s for s in calibrated if s["met"]]
-    text = (f"{len(met)} of {len(calibrated)} calibrated stages met their tolerance "
-            f"(the whole 95 % interval within ± tolerance of the estimate).")
+    lab = [s for s in calibrated if s.get("matches_lab")]
+    text = (f"{len(met)} of {len(calibrated)} calibrated stages are precise enough (the whole 95 % interval "
+            f"within ± tolerance of the estimate); {len(lab)} match the lab (the fitted response at the "
+            f"estimate within the lab band).")
     inherited = [s for s in stages if s["kind"] == "inherit"]
     if inherited:
         text += f" {len(inherited)} value{'s' if len(inherited) > 1 else ''} inherited from other materials."
@@ -60,13 +62,16 @@ def headline(stages):
 
 def _stage_table(stages):
     head = ("<table><tr><th>stage</th><th>parameter</th><th>estimate</th><th>95 % interval</th>"
-            "<th>tolerance</th><th>runs</th><th>verdict</th></tr>")
+            "<th>tolerance</th><th>runs</th><th>matches the lab</th><th>precise enough</th></tr>")
     rows, material = [head], None
     for s in stages:
         if s["material"] != material:
             material = s["material"]
-            rows.append(f"<tr class='mat'><td colspan='7'>{_esc(material)}</td></tr>")
-        verdict = (f"<span class='{'yes' if s['met'] else 'no'}'>{'met' if s['met'] else 'not met'}</span>"
+            rows.append(f"<tr class='mat'><td colspan='8'>{_esc(material)}</td></tr>")
+        lab = s.get("matches_lab")
+        matches = ("<span class='muted'>no band</span>" if lab is None else
+                   f"<span class='{'yes' if lab else 'no'}'>{'yes' if lab else 'no'}</span>")
+        verdict = (f"<span class='{'yes' if s['met'] else 'no'}'>{'yes' if s['met'] else 'no'}</span>"
                    f"<br><span class='muted'>{_esc(s['stop_reason'])}</span>")
         params = s["parameters"] or [None]
         for i, p in enumerate(params):
@@ -76,7 +81,8 @@ def _stage_table(stages):
             else:
                 cells += [_esc(p["label"]), _num(p["estimate"], p["unit"]),
                           f"{_num(p['low'])} - {_num(p['high'], p['unit'])}", "± " + _num(p["tolerance"], p["unit"])]
-            cells += [str(s.get("runs_requested", "")) if i == 0 else "", verdict if i == 0 else ""]
+            cells += [str(s.get("runs_requested", "")) if i == 0 else "", matches if i == 0 else "",
+                      verdict if i == 0 else ""]
             rows.append("<tr>" + "".join(f"<td{' class=num' if k in (2, 3, 4, 5) else ''}>{c}</td>"
                                          for k, c in enumerate(cells)) + "</tr>")
     rows.append("</table>")
@@ -104,11 +110,50 @@ def _stage_detail(study_dir, s):
                  f"({s.get('runs_simulated', 0)} simulated), {s.get('elapsed_s', 0):.0f} s; "
                  f"{_esc(s['stop_reason'])}: {_esc(s.get('message', ''))}")
     parts.append("<ul>" + "".join(f"<li>{line}</li>" for line in lines) + "</ul>")
+    parts.append(_held_table(s.get("held")))
+    parts.append(_gallery(study_dir, s.get("gallery")))
     for f in s.get("plots") or []:
         if not (study_dir / f).is_file():
             raise FileNotFoundError(f"{study_dir / f}: a plot named in summary.json is missing")
         parts.append(_img(study_dir, f))
     return "\n".join(parts)
+
+
+def _held_table(held):
+    """The values the stage held while it fitted its own, with where they came from."""
+    if not held:
+        return "<p class='muted'>held values: none (no other calibrated value of this material)</p>"
+    rows = "".join(f"<tr><td>{_esc(h['key'])}</td><td class=num>"
+                   f"{_num(h['value']) if isinstance(h['value'], (int, float)) else _esc(h['value'])}</td>"
+                   f"<td>{_esc(h['source'])}</td></tr>" for h in held)
+    return ("<details open><summary>held values (not fitted in this stage)</summary><table><tr><th>key</th>"
+            f"<th>value</th><th>from</th></tr>{rows}</table></details>")
+
+
+def _gallery(study_dir, pictures):
+    """The stage's simulated samples (pycal.calibration.gallery), small, with captions."""
+    if not pictures:
+        return ""
+    cells = "".join(f"<figure style='display:inline-block;width:32%;margin:0 1% 8px 0;vertical-align:top'>"
+                    f"{_img(study_dir, p['file'])}<figcaption class='muted'>{_esc(p['caption'])}</figcaption>"
+                    "</figure>" for p in pictures if (study_dir / p["file"]).is_file())
+    return f"<details open><summary>simulated samples</summary>{cells}</details>"
+
+
+def _provenance_items(summary):
+    """<li> lines of the provenance block (pycal.calibration.provenance)."""
+    p = summary.get("provenance") or {}
+    libs = ", ".join(f"{k} {v}" for k, v in (p.get("libraries") or {}).items())
+    dirty = p.get("git_dirty")
+    return "".join(f"<li>{_esc(k)}: {_esc(v)}</li>" for k, v in [
+        ("started", p.get("started_utc", "not recorded")), ("host", p.get("host", "not recorded")),
+        ("command", p.get("command", "not recorded")),
+        ("git commit", f"{summary.get('git_commit', 'unknown')}"
+                       + ("" if dirty is None else " (uncommitted changes)" if dirty else " (clean)")),
+        ("YADE of the runs", ", ".join(summary.get("yade_versions") or []) or "not recorded"),
+        ("libraries", libs or "not recorded"),
+        ("lab files", f"{p.get('lab_files_count', '?')} files, SHA-256 {p.get('lab_files_sha256', '?')}"),
+        ("study config", f"{summary.get('config_file', '')}, SHA-256 {p.get('study_config_sha256', '?')}")])
 
 
 def _validation(study_dir, rows):
@@ -219,10 +264,8 @@ def write_report(study_dir):
             parts.append(f"<tr><td>{_esc(k)}</td><td class=num>{_num(v) if isinstance(v, (int, float)) else _esc(v)}"
                          f"</td><td class=num>{shown}</td></tr>")
         parts.append("</table>")
-    parts.append("<h2>Provenance</h2><ul>"
-                 f"<li>git commit: {_esc(summary.get('git_commit', 'unknown'))}</li>"
-                 f"<li>YADE version of the runs: {_esc(versions)}</li>"
-                 f"<li>study config: {_esc(summary.get('config_file', ''))}; seeds {summary['seed_base']}, "
+    parts.append("<h2>Provenance</h2><ul>" + _provenance_items(summary)
+                 + f"<li>seeds {summary['seed_base']}, "
                  f"{summary['seed_base'] + 1}, ... (--seed-base)</li>"
                  "<li>every run's result.json (under the runs directory) holds its job, seed, YADE version and git "
                  "commit; runs.csv lists every run of the study</li></ul>"

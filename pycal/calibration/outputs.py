@@ -86,5 +86,6 @@ def write_all(study):
                "stages": study.stage_rows, "history": study.points,
                "runs": study.runs, "overrides": study.overrides, "intervals": study.intervals,
                "runs_requested": study.runs_requested, "elapsed_s": time.time() - study.t0,
-               "yade_versions": sorted(study.yade_versions), "git_commit": git_commit()}
+               "yade_versions": sorted(study.yade_versions), "git_commit": git_commit(),
+               "provenance": getattr(study, "provenance", {})}
     write_json(out / "summary.json", finite(summary))

@@ -23,7 +23,10 @@ from ..jobs import resolve_job
 from ..post import mean_std
 from ..post import responses as responses_mod
 from ..stats import stopping
-from . import outputs, targets
+from . import gallery, outputs, targets
+from .held import held_values
+from .provenance import study_provenance
+from .verdicts import matches_lab
 from .journal import Journal, fingerprint
 from .names import group_label, unit_of_key
 from .study_config import load_study
@@ -48,6 +51,7 @@ class Study:
         self.seeds = self.seeds_from_base(self.cfg["seeds_count"])
         self.overrides = {m: {} for m in self.cfg["materials"]}
         self.intervals = {m: {} for m in self.cfg["materials"]}   # key -> (estimate, low, high) found so far
+        self.value_source = {m: {} for m in self.cfg["materials"]}  # key -> the section that calibrated it
         self.stage_rows, self.points, self.runs = [], [], []
         self.validation_rows = []    # predictions of tests the calibration never saw (validation.py)
         self.run_at_check_rows = []  # stages that ran at other material values, at the calibrated ones
@@ -64,6 +68,7 @@ class Study:
         self.section = "study"       # what the runs are for now: '<material>/<stage>', 'validation/<name>' ...
         self.jobs = []               # every job asked: section, rig, seed, job id, status (outputs: jobs.csv)
         self.t0 = time.time()
+        self.provenance = study_provenance(self.config_path)
         self.journal = Journal(self.out / "journal.json")
         # every target now: a broken lab file stops the study before any run
         self.targets = {}
@@ -232,6 +237,7 @@ class Study:
         """Carry a calibrated value (and its (estimate, low, high)) into the next stages."""
         for k in keys:
             self.overrides[material][k] = value
+            self.value_source[material][k] = self.section
             if interval is not None:
                 self.intervals[material][k] = interval
 
@@ -288,6 +294,7 @@ class Study:
                 rig = st.get("rig") or ", ".join(r["rig"] for r in st.get("responses", []))
                 self.section = f"{material}/{st['label']}"
                 self.log(f"[stage {k}/{n_stages}] {material}: {st['label']}" + (f" on {rig}" if rig else ""))
+                held = held_values(self, material, st)
                 if st["kind"] == "inherit":
                     row = self.stage_inherit(material, st)
                 else:
@@ -304,6 +311,9 @@ class Study:
                             "runs_requested": self.runs_requested - runs_before,
                             "runs_simulated": simulated, "elapsed_s": round(elapsed, 1)})
                 row.setdefault("plots", [])
+                row["held"] = held
+                row["matches_lab"] = matches_lab(row)
+                row["gallery"] = gallery.stage_pictures(self, material, st, row) if st["kind"] != "inherit" else []
                 self.stage_rows.append(row)
                 for p in row["parameters"]:
                     self.log(f"  -> {p['label']} = {p['estimate']:.4g} [{p['low']:.4g}, {p['high']:.4g}] "

@@ -11,4 +11,4 @@ DESCRIPTOR = RigDescriptor(
     name="aor", script="aor.py",
     geometry=CELL + ("table_material", "table_radius_m"), procedure=POUR + LIFT, measure=PILE_READING,
     phases=phases, result_keys=AOR_RESULT, responses=("aor_mean_deg",), replicas_max=8,
-    check_job=particle_fits_cell, post="aor")
+    check_job=particle_fits_cell, post="aor", pictures=("pile_side.png",))

@@ -12,4 +12,5 @@ DESCRIPTOR = RigDescriptor(
     measure=PILE_READING + ("upper_fit_from_height_fraction", "upper_silhouette_slice_height_m",
                             "upper_exclude_apex_m"),
     phases=phases, result_keys=AOR_RESULT + ("aor_upper_mean_deg",), responses=("aor_mean_deg",),
-    accepts_material_sets=True, check_job=particle_fits_cell, post="aor_mixed")
+    accepts_material_sets=True, check_job=particle_fits_cell, post="aor_mixed",
+    pictures=("pile_side.png",))

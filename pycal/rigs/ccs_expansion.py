@@ -16,6 +16,6 @@ DESCRIPTOR = RigDescriptor(
     procedure=POUR + ("load_steps_pa", "unload_steps_pa") + SERVO,
     phases=phases, result_keys=COMPRESSION_RESULT + ("unloading_stiffness_pa", "unloading_stress_pa"),
     responses=("unloading_stiffness_log_ratio",), replicas_max=8, check_job=particle_fits_cell,
-    post="compression", lab_curves=("ccs_expansion", "ccs"),   # the loading branch: the sample's ccs curve
+    post="compression", lab_curves=("ccs_expansion", "ccs"), pictures=("spring_curve.png",),   # the loading branch: the sample's ccs curve
     comparisons=(("unloading_stiffness", "stiffness_pa", "particle_stiffness_pa", None, "unloading"),)
     + LOADING_COMPARISONS)

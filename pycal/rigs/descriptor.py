@@ -31,6 +31,7 @@ class RigDescriptor:
     post: str = ""                                  # its post-processing module (pycal/post/<post>.py)
     lab_curves: tuple = ()                          # rigs whose lab curves <rig>_<sample> it is compared with
     comparisons: tuple = ()                         # (misfit, result key, lab quantity, lab factor, branch)
+    pictures: tuple = ()                            # pictures a run writes that the report shows (file names)
 
     def keys(self, section):
         return tuple(getattr(self, section)) + tuple(k.split(".", 1)[1] for k in self.optional

@@ -8,4 +8,5 @@ DESCRIPTOR = RigDescriptor(
     geometry=CELL + ("cell_gap_m", "cell_mass_kg", "lid_mass_kg", "table_material", "table_half_width_m",
                      "lid_material"),
     procedure=POUR + TILT, phases=tilt_phases, result_keys=FRICTION_RESULT, responses=FRICTION_RESPONSES,
-    check_job=particle_fits_cell, post="friction")
+    check_job=particle_fits_cell, post="friction",
+    pictures=("friction_vs_stress.png",))

@@ -19,4 +19,4 @@ DESCRIPTOR = RigDescriptor(
     geometry=CELL + ("table_material", "table_radius_m"), procedure=POUR + LIFT + VIBRATION, measure=PILE_READING,
     phases=phases, result_keys=AOR_RESULT + ("surcharge_mean_deg", "surcharge_sectors_count"),
     responses=("aor_mean_deg", "surcharge_mean_deg"), replicas_max=8, check_job=particle_fits_cell,
-    post="aor")
+    post="aor", pictures=("pile_side.png", "surcharge_side.png"))

@@ -1,6 +1,8 @@
 """A fake executor for the calibration tests: known response laws, seed noise, and a job
 cache like pycal.runner's (a job asked again is not simulated again)."""
+import base64
 import random
+from pathlib import Path
 
 from pycal.errors import RunError
 
@@ -47,6 +49,9 @@ materials:
 """
 
 
+PNG_1PX = base64.b64decode("iVBORw0KGgoAAAANSUhEUgAAAAEAAAABCAYAAAAfFcSJAAAADUlEQVR42mP8z8BQDwAEhQGAhKmMIQAAAABJRU5ErkJggg==")
+
+
 class FakeRigs:
     """run(jobs, raise_on_error) -> results like runner.LocalPool, with .simulated_count and
     .last_errors. results: {rig: function(job) -> dict of measurements}; noise: {key: sd}
@@ -55,7 +60,7 @@ class FakeRigs:
     whatever the density); refuse(job) -> message or None."""
 
     def __init__(self, results=None, noise=None, relative=("bulk_density_kg_m3",), refuse=None, cache=None,
-                 seed_offsets=None):
+                 seed_offsets=None, runs_dir=None):
         self.results = {"fill": lambda j: {"bulk_density_kg_m3": bulk_law(j)},
                         "aor": lambda j: {"aor_mean_deg": aor_law(j)}, **(results or {})}
         self.noise = {"bulk_density_kg_m3": 0.005, "aor_mean_deg": 0.5, **(noise or {})}
@@ -64,6 +69,8 @@ class FakeRigs:
         self.refuse = refuse or (lambda job: None)
         self.cache = {} if cache is None else cache
         self.simulated_count, self.last_errors, self.asked = 0, [], []
+        if runs_dir is not None:     # each run writes its rig's pictures (a 1-pixel PNG) into its job folder
+            self.runs_dir = runs_dir     # (no attribute otherwise: replicas take a stand-in without one as such)
 
     def run(self, jobs, raise_on_error=True):
         out, self.last_errors = [], []
@@ -89,6 +96,12 @@ class FakeRigs:
             r.update({"rig": job["rig"], "material": job["material"], "seed": job["seed"], "job": job,
                       "job_id": job["job_id"], "provenance": {"yade_version": YADE_VERSION}})
             self.cache[job["job_id"]] = r
+            if getattr(self, "runs_dir", None) is not None:
+                from pycal import rigs
+                folder = Path(self.runs_dir) / job["rig"] / job["job_id"]
+                folder.mkdir(parents=True, exist_ok=True)
+                for name in rigs.get(job["rig"]).pictures:
+                    (folder / name).write_bytes(PNG_1PX)
             out.append(r)
         if self.last_errors and raise_on_error:
             raise RunError(self.last_errors[0])

@@ -1,0 +1,90 @@
+"""Pictures of a stage's simulated samples, for the report: the pictures a rig's runs
+write (its descriptor's `pictures`, e.g. the AoR rig's pile_side.png: the side
+silhouette with the fitted flanks and every sector's angle) at the point nearest the
+estimate and at the lowest and highest values the stage ran, first seed of each point,
+copied into <study>/plots/<material>-<stage>/gallery/.
+"""
+import json
+import math
+import shutil
+from pathlib import Path
+
+from .. import rigs
+from ..replicas import result_folder
+
+
+def runs_dir_of(executor):
+    """The runs folder of an executor (through wrappers such as ReplicaExecutor), or None."""
+    while executor is not None:
+        if getattr(executor, "runs_dir", None) is not None:
+            return Path(executor.runs_dir)
+        executor = getattr(executor, "inner", None)
+    return None
+
+
+def _chosen_points(row):
+    """[(caption, {key: value})]: the estimate, and for one parameter the interval's ends."""
+    params = [p for p in row.get("parameters") or [] if p.get("keys")]
+    if not params:
+        return []
+    est = {p["keys"][0]: p["estimate"] for p in params}
+    out = [("at the estimate", est)]
+    if len(params) == 1:
+        p = params[0]
+        out += [("lowest value run", {p["keys"][0]: -math.inf}), ("highest value run", {p["keys"][0]: math.inf})]
+    return out
+
+
+def _points_of(study, material, label, rig):
+    """The parameters ({key: value}, rig keys too) of every point the stage ran on `rig`."""
+    return [json.loads(k) for (m, s, r, k) in study.point_results if (m, s, r) == (material, label, rig)]
+
+
+def _nearest(study, material, label, rig, want):
+    """The results and parameters of the point nearest `want` ({key: value}; +-inf: the
+    highest / lowest value run)."""
+    points = _points_of(study, material, label, rig)
+    if not points:
+        return None, None
+    key = next(iter(want))
+    if math.isinf(want[key]):
+        values = [p for p in points if isinstance(p.get(key), (int, float))]
+        if not values:
+            return None, None
+        pick = (max if want[key] > 0 else min)(values, key=lambda p: p[key])
+        return study.nearest_point_results(material, label, rig, {key: pick[key]})
+    return study.nearest_point_results(material, label, rig, want)
+
+
+def stage_pictures(study, material, st, row):
+    """[{'file': path relative to the study folder, 'caption': ...}] of the stage's gallery."""
+    runs = runs_dir_of(study.executor)
+    rig_names = [st["rig"]] if st.get("rig") else [r["rig"] for r in st.get("responses", [])]
+    out, seen = [], set()
+    folder = study.out / "plots" / f"{material}-{st['label']}" / "gallery"
+    for rig in rig_names:
+        pictures = rigs.get(rig).pictures
+        if not pictures or runs is None:
+            continue
+        for caption, want in _chosen_points(row):
+            results, params = _nearest(study, material, st["label"], rig, want)
+            if not results or json_key(params) in seen:
+                continue
+            seen.add(json_key(params))
+            r = results[0]
+            src = Path(result_folder(r, r["job"], runs))
+            shown = ", ".join(f"{k.split('.')[-1]} {v:.3g}" for k, v in params.items()
+                              if isinstance(v, (int, float)) and not k.startswith("rig."))
+            for name in pictures:
+                if not (src / name).is_file():
+                    continue
+                dest = folder / f"{rig}-{len(out):02d}-{name}"
+                dest.parent.mkdir(parents=True, exist_ok=True)
+                shutil.copyfile(src / name, dest)
+                out.append({"file": str(dest.relative_to(study.out)), "rig": rig,
+                            "caption": f"{rig}, {caption} ({shown}), seed {r['seed']}: {name}"})
+    return out
+
+
+def json_key(params):
+    return json.dumps(params, sort_keys=True)

@@ -1,0 +1,40 @@
+"""The values a stage holds while it fits its own: every material key the study
+calibrates (or the stage sets) that this stage does not fit, with the value its runs use
+and where that value comes from (a stage before it, this stage's `set` / `run_at`, or the
+material config's start value), and the stage's rig overrides. Shown in the report."""
+
+
+def stage_keys(st):
+    """Material keys the stage fits (1-D `parameter`, joint `parameters`, inherited `keys`)."""
+    params = st.get("parameters") or ([st["parameter"]] if st.get("parameter") else [])
+    keys = [k for p in params for k in p["keys"]]
+    return keys + list(st.get("keys") or [])
+
+
+def held_values(study, material, st):
+    """[{'key', 'value', 'source'}] of stage `st` of `material`, taken when it starts."""
+    fitted = set(stage_keys(st))
+    studied = [k for s in study.cfg["materials"][material] for k in stage_keys(s)]
+    keys = list(dict.fromkeys(studied + list(st.get("set") or {}) + list(st.get("run_at") or {})))
+    out = []
+    for k in keys:
+        if k in fitted:
+            continue
+        if k in (st.get("run_at") or {}):
+            value, source = st["run_at"][k], "run_at of this stage (not carried on)"
+        elif k in (st.get("set") or {}):
+            value, source = st["set"][k], "set by this stage"
+        elif k in study.overrides[material]:
+            value, source = study.overrides[material][k], f"calibrated: {study.value_source[material].get(k, '?')}"
+        else:
+            try:
+                value, source = study.current_value(material, k), f"start value (configs/materials/{material}.yaml)"
+            except (KeyError, TypeError):
+                continue                    # a key a later stage's `set` brings in: not held here
+        out.append({"key": k, "value": value, "source": source})
+    for k, v in (st.get("rig_overrides") or {}).items():
+        out.append({"key": k, "value": v, "source": "rig override of this stage"})
+    for r in st.get("responses") or []:
+        for k, v in (r.get("rig_overrides") or {}).items():
+            out.append({"key": k, "value": v, "source": f"rig override ({r['rig']})"})
+    return out
