@@ -38,9 +38,9 @@ def _cmd_calibrate(args):
     from .study import cost_per_material
     study, runs = _study(args)
     t0 = time.time()
-    print(f"calibration study {study.cfg['name']} ({args.config}): {len(study.seeds)} seeds per point, "
-          f"new at every point of a stage (seeds {study.seeds[0]}, {study.seeds[0] + 1}, ...), runs cached in {runs}; interrupt at any time "
-          f"and run again to resume")
+    print(f"calibration study {study.cfg['name']} ({args.config}):\n  {len(study.seeds)} seeds per point, "
+          f"new at every point of a stage (seeds {study.seeds[0]}, {study.seeds[0] + 1}, ...)\n"
+          f"  runs cached in {runs}; interrupt at any time and run again to resume")
     rows = study.run()
     report = write_report(study.out)
     calibrated = [r for r in rows if r["kind"] != "inherit"]

@@ -176,8 +176,8 @@ class Study:
                             "response": response.name, "mean": m, "std": s, "n": len(values),
                             "seeds": list(self.last_seeds)})
         shown = f"{m:.4g} +/- {s:.2g}" if scalar else f"{len(values)} vectors"
-        self.log(f"  {material} {stage}: {_fmt_params(params)} -> {response.name} = {shown} (n={len(values)}; "
-                 f"runs requested {self.runs_requested}, elapsed {time.time() - self.t0:.0f} s)")
+        self.log(f"  {_fmt_params(params)} -> {response.name} {shown} (n {len(values)}; study runs "
+                 f"{self.runs_requested}, {time.time() - self.t0:.0f} s)")
         return values
 
     def nearest_point_results(self, material, stage, rig, extra):
@@ -360,8 +360,15 @@ def failed_row(study, material, st, exc):
 
 
 def _fmt_params(params):
-    """'M2.rolling_resistance_coefficient = 0.35, ...' (the key without its first part)."""
-    return ", ".join(f"{k.split('.', 1)[-1]} = {v:.4g}" for k, v in params.items()) or "-"
+    """'rolling resistance (M2, steel, PVC) = 0.35': keys set to one value shown as their group."""
+    groups = {}
+    for k, v in params.items():
+        groups.setdefault(json.dumps(v), []).append(k)
+    return ", ".join(f"{group_label(keys)} = {_short(json.loads(v))}" for v, keys in groups.items()) or "-"
+
+
+def _short(v):
+    return f"{v:.4g}" if isinstance(v, (int, float)) and not isinstance(v, bool) else str(v)
 
 
 def cost_per_material(stage_rows):
