@@ -256,13 +256,15 @@ def write_report(study_dir):
     parts.append("<h2>Calibrated material files</h2>")
     for mat, ov in summary["overrides"].items():
         iv = summary.get("intervals", {}).get(mat, {})
-        parts.append(f"<h3>{_esc(mat)}</h3><p class='muted'>calibrated/{_esc(mat)}.yaml</p>"
-                     "<table><tr><th>config key</th><th>value</th><th>95 % interval</th></tr>")
+        src = (summary.get("value_sources") or {}).get(mat, {})
+        parts.append(f"<h3>{_esc(mat)}</h3><p class='muted'>calibrated/{_esc(mat)}.yaml (loads as a material "
+                     f"config); calibrated/{_esc(mat)}.calibration.yaml: intervals, stages, start values, commit</p>"
+                     "<table><tr><th>config key</th><th>value</th><th>95 % interval</th><th>stage</th></tr>")
         for k, v in ov.items():
             rng = iv.get(k)
             shown = f"{_num(rng[1])} - {_num(rng[2])}" if rng else ""
             parts.append(f"<tr><td>{_esc(k)}</td><td class=num>{_num(v) if isinstance(v, (int, float)) else _esc(v)}"
-                         f"</td><td class=num>{shown}</td></tr>")
+                         f"</td><td class=num>{shown}</td><td>{_esc(src.get(k, ''))}</td></tr>")
         parts.append("</table>")
     parts.append("<h2>Provenance</h2><ul>" + _provenance_items(summary)
                  + f"<li>seeds {summary['seed_base']}, "

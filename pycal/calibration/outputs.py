@@ -63,12 +63,46 @@ def stage_table(rows):
     return out
 
 
+def calibration_record(study, material):
+    """What calibrated/<material>.yaml's values are: per key the value, its 95 % interval,
+    the stage that found it and the config's start value; the keys the study meant to
+    calibrate that kept their start value (a stage not run or failed); the study, its
+    start, commit and dirty flag."""
+    from .held import stage_keys
+    prov = getattr(study, "provenance", {})
+    calibrated, kept = {}, {}
+    for k in dict.fromkeys(k for st in study.cfg["materials"][material] for k in stage_keys(st)):
+        try:
+            start = _plain(study.start_value(material, k))
+        except (KeyError, TypeError):
+            start = None
+        if k in study.overrides[material]:
+            iv = study.intervals[material].get(k)
+            calibrated[k] = {"value": _plain(study.overrides[material][k]),
+                             "interval_95": [_plain(iv[1]), _plain(iv[2])] if iv else None,
+                             "stage": study.value_source[material].get(k), "start_value": start}
+        else:
+            kept[k] = {"start_value": start, "note": "not calibrated: start value of the config"}
+    return {"material": material, "study": study.cfg["name"], "study_config": str(study.config_path),
+            "started_utc": prov.get("started_utc"), "git_commit": prov.get("git_commit"),
+            "git_dirty": prov.get("git_dirty"), "calibrated": calibrated, "start_values": kept}
+
+
+def _plain(v):
+    """A YAML-safe number (NaN -> None)."""
+    if isinstance(v, float) and v != v:
+        return None
+    return float(v) if isinstance(v, float) else v
+
+
 def write_all(study):
     """Write every output file of the study as it stands."""
     out = study.out
     for m in study.cfg["materials"]:
         write_text(out / "calibrated" / f"{m}.yaml", yaml.safe_dump(study.calibrated_material(m),
                                                                          sort_keys=False))
+        write_text(out / "calibrated" / f"{m}.calibration.yaml", yaml.safe_dump(calibration_record(study, m),
+                                                                                 sort_keys=False))
     write_csv(out / "stages.csv", STAGE_COLUMNS, stage_table(study.stage_rows))
     write_csv(out / "history.csv", POINT_COLUMNS,
                      [[_cell(p[c]) for c in POINT_COLUMNS] for p in study.points])
@@ -87,5 +121,6 @@ def write_all(study):
                "runs": study.runs, "overrides": study.overrides, "intervals": study.intervals,
                "runs_requested": study.runs_requested, "elapsed_s": time.time() - study.t0,
                "yade_versions": sorted(study.yade_versions), "git_commit": git_commit(),
-               "provenance": getattr(study, "provenance", {})}
+               "provenance": getattr(study, "provenance", {}),
+               "value_sources": getattr(study, "value_source", {})}
     write_json(out / "summary.json", finite(summary))

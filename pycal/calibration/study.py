@@ -200,14 +200,18 @@ class Study:
         labresults/, e.g. a synthetic twin's), else None = labresults/."""
         return (self.config_path.parent / st["lab_dir"]) if st.get("lab_dir") else None
 
-    def current_value(self, material, key):
-        """The value a material key has at this point of the study (calibrated or config)."""
-        if key in self.overrides[material]:
-            return self.overrides[material][key]
+    def start_value(self, material, key):
+        """The value a material key has in its config (configs/materials/<material>.yaml)."""
         node = load_material(material)
         for part in key.split("."):
             node = node[part]
         return node
+
+    def current_value(self, material, key):
+        """The value a material key has at this point of the study (calibrated or config)."""
+        if key in self.overrides[material]:
+            return self.overrides[material][key]
+        return self.start_value(material, key)
 
     def stage_journal(self, material, st):
         """The journal of a stage (pycal.calibration.journal), keyed by what it starts from:

@@ -692,3 +692,20 @@ def test_report_shows_pictures_held_values_both_verdicts_and_provenance(tmp_path
     for field in ("host:", "command:", "libraries:", "python 3", "sklearn", "emcee", "lab files:", "SHA-256",
                   "study config:"):
         assert field in prov, field
+
+
+def test_calibrated_files_say_which_values_were_calibrated_with_intervals_and_which_are_start_values(
+        tmp_path, study_file):
+    cfg = tmp_path / "noisy.yaml"       # the wet cohesion stage refuses every run: its key keeps its start value
+    cfg.write_text(STUDY)
+    ex = FakeRigs(refuse=lambda job: "no rest" if job["material"] == "M3-wet" and job["rig"] == "aor" else None)
+    study = Study(cfg, ex, tmp_path / "out", log=quiet)
+    study.run()
+    rec = yaml.safe_load((study.out / "calibrated" / "M3-dry.calibration.yaml").read_text())
+    rr = rec["calibrated"]["interactions.M3-dry.rolling_resistance_coefficient"]
+    assert rr["stage"] == "M3-dry/rolling_resistance" and rr["start_value"] == 0.35
+    assert rr["interval_95"][0] <= rr["value"] <= rr["interval_95"][1]
+    assert rec["git_commit"] and rec["started_utc"]
+    wet = yaml.safe_load((study.out / "calibrated" / "M3-wet.calibration.yaml").read_text())
+    assert "interactions.M3-wet.cohesion.force_fraction" in wet["start_values"]
+    assert wet["calibrated"]["interactions.M3-wet.rolling_resistance_coefficient"]["stage"] == "M3-wet/inherit"
