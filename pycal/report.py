@@ -112,6 +112,7 @@ def _stage_detail(study_dir, s):
     parts.append("<ul>" + "".join(f"<li>{line}</li>" for line in lines) + "</ul>")
     parts.append(_held_table(s.get("held")))
     parts.append(_gallery(study_dir, s.get("gallery")))
+    parts.append(_aor_seeds(s.get("aor_seeds")))
     for f in s.get("plots") or []:
         if not (study_dir / f).is_file():
             raise FileNotFoundError(f"{study_dir / f}: a plot named in summary.json is missing")
@@ -138,6 +139,26 @@ def _gallery(study_dir, pictures):
                     f"{_img(study_dir, p['file'])}<figcaption class='muted'>{_esc(p['caption'])}</figcaption>"
                     "</figure>" for p in pictures if (study_dir / p["file"]).is_file())
     return f"<details open><summary>simulated samples</summary>{cells}</details>"
+
+
+def _aor_seeds(a):
+    """The pile as the lab reads it: per seed left / right / front / back at the point nearest
+    the estimate, and the lab's left / right."""
+    if not a or not a.get("seeds"):
+        return ""
+    head = ("<table><tr><th>seed</th><th>left</th><th>right</th><th>front</th><th>back</th><th>mean of the sides "
+            "with an angle</th><th>sides</th></tr>")
+    rows = "".join("<tr>" + "".join(f"<td class=num>{c}</td>" for c in (
+        x["seed"], _num(x["aor_left_deg"], "deg"), _num(x["aor_right_deg"], "deg"), _num(x["aor_front_deg"], "deg"),
+        _num(x["aor_back_deg"], "deg"), _num(x["aor_mean_deg"], "deg"), x.get("aor_sectors_count", "-"))) + "</tr>"
+                   for x in a["seeds"])
+    lab = a.get("lab")
+    if lab:
+        rows += (f"<tr><td>lab ({_esc(lab['sample'])})</td><td class=num>{_num(lab['left_deg'], 'deg')}</td>"
+                 f"<td class=num>{_num(lab['right_deg'], 'deg')}</td><td>-</td><td>-</td><td>-</td><td>-</td></tr>")
+    at = ", ".join(f"{k.split('.')[-1]} {_num(v)}" for k, v in a["point"].items() if isinstance(v, (int, float)))
+    return (f"<details open><summary>the pile per seed at the point nearest the estimate ({_esc(at)}), "
+            f"as the lab reads it</summary>{head}{rows}</table></details>")
 
 
 def _provenance_items(summary):

@@ -88,3 +88,37 @@ def stage_pictures(study, material, st, row):
 
 def json_key(params):
     return json.dumps(params, sort_keys=True)
+
+
+ANGLE_KEYS = ("aor_left_deg", "aor_right_deg", "aor_front_deg", "aor_back_deg", "aor_mean_deg", "aor_sectors_count")
+
+
+def aor_seed_angles(study, material, st, row):
+    """The AoR as the lab reads it, at the point nearest the estimate: per seed the left,
+    right, front and back flank angles (deg, None: no angle on that side), their mean and
+    the sector count, and the lab's own left / right of the stage's target sample.
+    {} for a stage that is not read from a pile."""
+    reads = [(st["rig"], st.get("response"), st.get("target"))] if st.get("rig") else [
+        (r["rig"], r["response"], r.get("target")) for r in st.get("responses") or []]
+    reads = [(rig, t) for rig, resp, t in reads if resp == "aor_mean_deg"]
+    points = _chosen_points(row)
+    if not reads or not points:
+        return {}
+    rig, target = reads[0][0], reads[0][1] or {}
+    results, params = _nearest(study, material, st["label"], rig, points[0][1])
+    if not results:
+        return {}
+    seeds = [{"seed": r["seed"], **{k: r.get(k) for k in ANGLE_KEYS}} for r in results]
+    lab = None
+    if target.get("sample"):
+        from .. import LAB_DIR
+        from ..labdata import sample
+        try:
+            lab_row = sample(target["sample"], study.lab_dir(st) or LAB_DIR)[target.get("test", "angle_of_repose")]
+        except Exception:  # noqa: BLE001  (a report never fails on a lab lookup)
+            lab_row = None
+        if lab_row:
+            lab = {"sample": target["sample"], "left_deg": lab_row.get("left_deg"),
+                   "right_deg": lab_row.get("right_deg")}
+    return {"rig": rig, "point": {k: v for k, v in params.items() if not k.startswith("rig.")}, "seeds": seeds,
+            "lab": lab}

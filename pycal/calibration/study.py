@@ -318,6 +318,7 @@ class Study:
                 row["held"] = held
                 row["matches_lab"] = matches_lab(row)
                 row["gallery"] = gallery.stage_pictures(self, material, st, row) if st["kind"] != "inherit" else []
+                row["aor_seeds"] = gallery.aor_seed_angles(self, material, st, row) if st["kind"] != "inherit" else {}
                 self.stage_rows.append(row)
                 for p in row["parameters"]:
                     self.log(f"  -> {p['label']} = {p['estimate']:.4g} [{p['low']:.4g}, {p['high']:.4g}] "

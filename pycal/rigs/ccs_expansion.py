@@ -16,6 +16,7 @@ DESCRIPTOR = RigDescriptor(
     procedure=POUR + ("load_steps_pa", "unload_steps_pa") + SERVO,
     phases=phases, result_keys=COMPRESSION_RESULT + ("unloading_stiffness_pa", "unloading_stress_pa"),
     responses=("unloading_stiffness_log_ratio",), replicas_max=8, check_job=particle_fits_cell,
-    post="compression", lab_curves=("ccs_expansion", "ccs"), pictures=("spring_curve.png",),   # the loading branch: the sample's ccs curve
+    # lab curves: its own, and the sample's ccs curve for the loading branch
+    post="compression", lab_curves=("ccs_expansion", "ccs"), pictures=("spring_curve.png",),
     comparisons=(("unloading_stiffness", "stiffness_pa", "particle_stiffness_pa", None, "unloading"),)
     + LOADING_COMPARISONS)

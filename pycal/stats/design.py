@@ -50,8 +50,9 @@ def next_point_1d(model, crossings_u, lo_u, hi_u, runs_count):
 def next_point_nd(models, samples_u, runs_count, rng, avoid=()):
     """u (d,) of the next point of a joint stage: the candidate (drawn from the posterior
     samples inside the box of the 95 % marginal intervals, plus the posterior median) that
-    most reduces the variance of every output, each output's reduction relative to its current variance at the samples (and, as in
-    1-D, a far candidate keeps exp(-d^2 / 2 DISTANCE_SCALE_U^2) of its gain). avoid:
+    most reduces the variance of every output, each output's reduction relative to its
+    current variance at the samples (and, as in 1-D, a far candidate keeps
+    exp(-d^2 / 2 DISTANCE_SCALE_U^2) of its gain). avoid:
     (centre, radius) balls in u around points the rig refused: no candidate there."""
     S = np.asarray(samples_u, dtype=float)
     ref = S[rng.choice(len(S), size=min(len(S), 60), replace=False)]

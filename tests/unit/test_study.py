@@ -684,8 +684,11 @@ def test_report_shows_pictures_held_values_both_verdicts_and_provenance(tmp_path
     cohesion = rows[("M3-wet", "cohesion")]
     held = {h["key"]: h["source"] for h in cohesion["held"]}
     assert held["interactions.M3-wet.rolling_resistance_coefficient"] == "calibrated: M3-wet/inherit"
+    seeds = rolling["aor_seeds"]
+    assert [x["seed"] for x in seeds["seeds"]] and seeds["lab"]["sample"] == "fines_dry"
     html = write_report(tmp_path / "out" / "twin").read_text()
     assert "<th>matches the lab</th><th>precise enough</th>" in html
+    assert html.count("as the lab reads it") == 2          # the two AoR stages
     assert html.count("held values (not fitted in this stage)") == 3
     assert html.count("<figure") == 6                       # 3 per AoR stage; the fill writes no picture
     prov = html.split("<h2>Provenance</h2>")[1]
