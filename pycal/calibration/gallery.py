@@ -64,7 +64,7 @@ def stage_pictures(study, material, st, row):
     folder = study.out / "plots" / f"{material}-{st['label']}" / "gallery"
     for rig in rig_names:
         pictures = rigs.get(rig).pictures
-        if not pictures or runs is None:
+        if not (pictures or rigs.get(rig).trace) or runs is None:
             continue
         for caption, want in _chosen_points(row):
             results, params = _nearest(study, material, st["label"], rig, want)
@@ -75,6 +75,13 @@ def stage_pictures(study, material, st, row):
             src = Path(result_folder(r, r["job"], runs))
             shown = ", ".join(f"{k.split('.')[-1]} {v:.3g}" for k, v in params.items()
                               if isinstance(v, (int, float)) and not k.startswith("rig."))
+            trace = rigs.get(rig).trace
+            if trace is not None:
+                dest = folder / f"{rig}-{len(out):02d}-tilt_trace.png"
+                dest.parent.mkdir(parents=True, exist_ok=True)
+                if trace(src, r["job"], dest):
+                    out.append({"file": str(dest.relative_to(study.out)), "rig": rig,
+                                "caption": f"{rig}, {caption} ({shown}), seed {r['seed']}: slide against tilt"})
             for name in pictures:
                 if not (src / name).is_file():
                     continue

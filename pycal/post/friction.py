@@ -295,6 +295,34 @@ def write_plot(summary, comparisons, path, title):
     return save_png(fig, path)
 
 
+def write_tilt_trace(record_csv, path, onset_m=None, stresses_pa=()):
+    """tilt_trace.png from a run's tilt_record.csv: the mobile cell's slide (mm) against the
+    tilt angle (deg), one line per consolidation step (its stress, Pa, from stresses_pa), the
+    onset distance dashed. Returns
+    the path, or None when the record has no rows."""
+    import csv
+    from ..plotting import new_figure, save_png
+    steps = {}
+    with open(record_csv, newline="") as f:
+        for row in csv.DictReader(f):
+            steps.setdefault(int(row["step_index_count"]), []).append(
+                (float(row["tilt_deg"]), 1e3 * float(row["slide_displacement_m"])))
+    if not steps:
+        return None
+    fig, ax = new_figure(figsize=(5, 3.4))
+    for k, pts in sorted(steps.items()):
+        at = f" ({stresses_pa[k] / 1e3:g} kPa)" if k < len(stresses_pa) else ""
+        ax.plot([p[0] for p in pts], [p[1] for p in pts], lw=1, label=f"step {k + 1}{at}")
+    if onset_m:
+        ax.axhline(1e3 * onset_m, ls="--", color="k", lw=0.8, label="onset distance")
+    ax.set_xlabel("tilt (deg)")
+    ax.set_ylabel("slide of the mobile cell (mm)")
+    ax.grid(alpha=0.3)
+    ax.legend(fontsize=7)
+    fig.tight_layout()
+    return save_png(fig, path)
+
+
 def write_outputs(results, out_dir, lab_dir=None, targets=None, plots=True):
     """CSV + PNG for one or several results (dicts or paths to result.json) of one job
     (seeds). targets: as load_targets (default: the lab curve of the rig and the

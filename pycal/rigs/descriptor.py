@@ -32,6 +32,8 @@ class RigDescriptor:
     lab_curves: tuple = ()                          # rigs whose lab curves <rig>_<sample> it is compared with
     comparisons: tuple = ()                         # (misfit, result key, lab quantity, lab factor, branch)
     pictures: tuple = ()                            # pictures a run writes that the report shows (file names)
+    trace: Optional[Callable] = None                # (run folder, job, png path) -> png path or None: a picture
+                                                    # the report draws from a run's records
 
     def keys(self, section):
         return tuple(getattr(self, section)) + tuple(k.split(".", 1)[1] for k in self.optional
@@ -94,6 +96,17 @@ def tilt_phases(job, wait, settle_key):
         out.append((f"tilt back and settle ({n} steps)", n * (max_tilt / p["tilt_return_rate_deg_s"] + wait),
                     "rig.procedure.tilt_return_rate_deg_s"))
     return out
+
+
+def tilt_trace(folder, job, path):
+    """The tilt rigs' trace (pycal.post.friction.write_tilt_trace) from a run's tilt_record.csv."""
+    from pathlib import Path
+    from ..post.friction import write_tilt_trace
+    record = Path(folder) / "tilt_record.csv"
+    if not record.is_file():
+        return None
+    p = job["rig_config"]["procedure"]
+    return write_tilt_trace(record, path, p.get("slide_onset_displacement_m"), p.get("consolidation_stresses_pa", ()))
 
 
 def particle_fits_cell(job):

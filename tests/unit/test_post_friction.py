@@ -144,3 +144,15 @@ def test_friction_angle_offset_counts_hanging_on_as_90_deg_on_both_sides():
     lab_50 = 35.0 + (90.0 - 35.0) * math.log(50000 / 40000) / math.log(60000 / 40000)
     assert friction.friction_angle_offset_deg(at_50, targets=t) == pytest.approx(
         math.degrees(math.atan(0.70)) - lab_50, abs=0.05)
+
+
+def test_tilt_trace_draws_one_line_per_step(tmp_path):
+    from pycal.post.friction import write_tilt_trace
+    rec = tmp_path / "tilt_record.csv"
+    rec.write_text("step_index_count,time_s,tilt_deg,slide_displacement_m,cell_gap_m,plate_force_x_n,"
+                   "plate_force_y_n,plate_force_z_n\n0,0.1,1.0,0.0001,0.002,0,0,-1\n0,0.2,2.0,0.0012,0.002,0,0,-1\n"
+                   "1,0.1,1.0,0.0000,0.002,0,0,-1\n1,0.2,3.0,0.0011,0.002,0,0,-1\n")
+    out = write_tilt_trace(rec, tmp_path / "t.png", 0.001, [12000, 90000])
+    assert out and (tmp_path / "t.png").stat().st_size > 1000
+    (tmp_path / "empty.csv").write_text(rec.read_text().splitlines()[0] + "\n")
+    assert write_tilt_trace(tmp_path / "empty.csv", tmp_path / "e.png") is None
