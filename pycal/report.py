@@ -156,7 +156,7 @@ def _aor_seeds(a):
     if lab:
         rows += (f"<tr><td>lab ({_esc(lab['sample'])})</td><td class=num>{_num(lab['left_deg'], 'deg')}</td>"
                  f"<td class=num>{_num(lab['right_deg'], 'deg')}</td><td>-</td><td>-</td><td>-</td><td>-</td></tr>")
-    at = ", ".join(f"{k.split('.')[-1]} {_num(v)}" for k, v in a["point"].items() if isinstance(v, (int, float)))
+    at = a["point"]
     return (f"<details open><summary>the pile per seed at the point nearest the estimate ({_esc(at)}), "
             f"as the lab reads it</summary>{head}{rows}</table></details>")
 

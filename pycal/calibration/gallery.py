@@ -4,6 +4,7 @@ silhouette with the fitted flanks and every sector's angle) at the point nearest
 estimate and at the lowest and highest values the stage ran, first seed of each point,
 copied into <study>/plots/<material>-<stage>/gallery/.
 """
+import importlib
 import json
 import math
 import shutil
@@ -11,6 +12,15 @@ from pathlib import Path
 
 from .. import rigs
 from ..replicas import result_folder
+from .names import format_params
+
+
+def _trace_of(rig):
+    """trace_picture of the rig's post-processing module (pycal/post/<post>.py), or None."""
+    post = rigs.get(rig).post
+    if not post:
+        return None
+    return getattr(importlib.import_module(f"pycal.post.{post}"), "trace_picture", None)
 
 
 def runs_dir_of(executor):
@@ -64,7 +74,7 @@ def stage_pictures(study, material, st, row):
     folder = study.out / "plots" / f"{material}-{st['label']}" / "gallery"
     for rig in rig_names:
         pictures = rigs.get(rig).pictures
-        if not (pictures or rigs.get(rig).trace) or runs is None:
+        if not (pictures or _trace_of(rig)) or runs is None:
             continue
         for caption, want in _chosen_points(row):
             results, params = _nearest(study, material, st["label"], rig, want)
@@ -73,9 +83,8 @@ def stage_pictures(study, material, st, row):
             seen.add(json_key(params))
             r = results[0]
             src = Path(result_folder(r, r["job"], runs))
-            shown = ", ".join(f"{k.split('.')[-1]} {v:.3g}" for k, v in params.items()
-                              if isinstance(v, (int, float)) and not k.startswith("rig."))
-            trace = rigs.get(rig).trace
+            shown = format_params(params)
+            trace = _trace_of(rig)
             if trace is not None:
                 dest = folder / f"{rig}-{len(out):02d}-tilt_trace.png"
                 dest.parent.mkdir(parents=True, exist_ok=True)
@@ -127,5 +136,4 @@ def aor_seed_angles(study, material, st, row):
         if lab_row:
             lab = {"sample": target["sample"], "left_deg": lab_row.get("left_deg"),
                    "right_deg": lab_row.get("right_deg")}
-    return {"rig": rig, "point": {k: v for k, v in params.items() if not k.startswith("rig.")}, "seeds": seeds,
-            "lab": lab}
+    return {"rig": rig, "point": format_params(params), "seeds": seeds, "lab": lab}

@@ -55,3 +55,18 @@ def unit_of_key(key):
 def unit_label(unit):
     """'kg/m3', 'Pa', or '-' for dimensionless."""
     return UNIT_LABELS.get(unit, unit or "-")
+
+
+def format_params(params):
+    """'rolling resistance (M2, steel, PVC) = 0.35': the material keys of a point ({key:
+    value}), keys set to one value shown as their group; rig keys left out."""
+    import json
+    groups = {}
+    for k, v in params.items():
+        if not k.startswith("rig."):
+            groups.setdefault(json.dumps(v), []).append(k)
+    return ", ".join(f"{group_label(keys)} = {_short(json.loads(v))}" for v, keys in groups.items()) or "-"
+
+
+def _short(v):
+    return f"{v:.4g}" if isinstance(v, (int, float)) and not isinstance(v, bool) else str(v)

@@ -28,7 +28,7 @@ from .held import held_values
 from .provenance import study_provenance
 from .verdicts import matches_lab
 from .journal import Journal, fingerprint
-from .names import group_label, unit_of_key
+from .names import format_params, group_label, unit_of_key
 from .study_config import load_study
 
 SEED_SCHEME = "fresh seeds at every point"   # in the stage fingerprint: journals of the old scheme start afresh
@@ -142,7 +142,7 @@ class Study:
                    if not isinstance(v, list) and (v is None or math.isnan(v))]
         if not missing:
             return values, results
-        where = _fmt_params({k: v for k, v in extra.items() if not k.startswith("rig.")})
+        where = format_params({k: v for k, v in extra.items() if not k.startswith("rig.")})
         if len(missing) > max(1, len(values) // 3):
             raise RunError(f"{rig}: {response.name} has no value on seeds {missing} of {list(self.last_seeds)} "
                            f"at {where} (the rig ran, the response could not be read: e.g. a pile too flat "
@@ -176,7 +176,7 @@ class Study:
                             "response": response.name, "mean": m, "std": s, "n": len(values),
                             "seeds": list(self.last_seeds)})
         shown = f"{m:.4g} +/- {s:.2g}" if scalar else f"{len(values)} vectors"
-        self.log(f"  {_fmt_params(params)} -> {response.name} {shown} (n {len(values)}; study runs "
+        self.log(f"  {format_params(params)} -> {response.name} {shown} (n {len(values)}; study runs "
                  f"{self.runs_requested}, {time.time() - self.t0:.0f} s)")
         return values
 
@@ -362,18 +362,6 @@ def failed_row(study, material, st, exc):
                            "target_source": t.source} for n, t in zip(names, tg)],
             "met": False, "stop_reason": "runs failed" if isinstance(exc, RunError) else stopping.STUDY_BUDGET,
             "message": str(exc), "points_count": 0}
-
-
-def _fmt_params(params):
-    """'rolling resistance (M2, steel, PVC) = 0.35': keys set to one value shown as their group."""
-    groups = {}
-    for k, v in params.items():
-        groups.setdefault(json.dumps(v), []).append(k)
-    return ", ".join(f"{group_label(keys)} = {_short(json.loads(v))}" for v, keys in groups.items()) or "-"
-
-
-def _short(v):
-    return f"{v:.4g}" if isinstance(v, (int, float)) and not isinstance(v, bool) else str(v)
 
 
 def cost_per_material(stage_rows):

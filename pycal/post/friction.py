@@ -323,6 +323,16 @@ def write_tilt_trace(record_csv, path, onset_m=None, stresses_pa=()):
     return save_png(fig, path)
 
 
+def trace_picture(folder, job, path):
+    """The report's picture of one tilt run (pycal.calibration.gallery): its tilt_record.csv
+    as write_tilt_trace draws it; None without a record."""
+    record = os.path.join(folder, "tilt_record.csv")
+    if not os.path.isfile(record):
+        return None
+    p = job["rig_config"]["procedure"]
+    return write_tilt_trace(record, path, p.get("slide_onset_displacement_m"), p.get("consolidation_stresses_pa", ()))
+
+
 def write_outputs(results, out_dir, lab_dir=None, targets=None, plots=True):
     """CSV + PNG for one or several results (dicts or paths to result.json) of one job
     (seeds). targets: as load_targets (default: the lab curve of the rig and the

@@ -28,12 +28,12 @@ class RigDescriptor:
     replicas_max: int = 0                           # 0: no replicas (one seed per YADE run)
     accepts_material_sets: bool = False
     check_job: Optional[Callable] = None            # (job) -> None or raises ConfigError
-    post: str = ""                                  # its post-processing module (pycal/post/<post>.py)
+    post: str = ""                                  # its post-processing module (pycal/post/<post>.py; its
+                                                    # trace_picture(folder, job, path), if any, draws a run's
+                                                    # records for the report)
     lab_curves: tuple = ()                          # rigs whose lab curves <rig>_<sample> it is compared with
     comparisons: tuple = ()                         # (misfit, result key, lab quantity, lab factor, branch)
     pictures: tuple = ()                            # pictures a run writes that the report shows (file names)
-    trace: Optional[Callable] = None                # (run folder, job, png path) -> png path or None: a picture
-                                                    # the report draws from a run's records
 
     def keys(self, section):
         return tuple(getattr(self, section)) + tuple(k.split(".", 1)[1] for k in self.optional
@@ -96,17 +96,6 @@ def tilt_phases(job, wait, settle_key):
         out.append((f"tilt back and settle ({n} steps)", n * (max_tilt / p["tilt_return_rate_deg_s"] + wait),
                     "rig.procedure.tilt_return_rate_deg_s"))
     return out
-
-
-def tilt_trace(folder, job, path):
-    """The tilt rigs' trace (pycal.post.friction.write_tilt_trace) from a run's tilt_record.csv."""
-    from pathlib import Path
-    from ..post.friction import write_tilt_trace
-    record = Path(folder) / "tilt_record.csv"
-    if not record.is_file():
-        return None
-    p = job["rig_config"]["procedure"]
-    return write_tilt_trace(record, path, p.get("slide_onset_displacement_m"), p.get("consolidation_stresses_pa", ()))
 
 
 def particle_fits_cell(job):

@@ -1,7 +1,7 @@
 """internal_friction: two stacked cells on a tilt table (calibrates particle-particle
 friction). No replicas (gravity is rotated for the whole scene)."""
 from ._cells import CELL, FRICTION_RESPONSES, FRICTION_RESULT, POUR, TILT
-from .descriptor import RigDescriptor, particle_fits_cell, tilt_phases, tilt_trace
+from .descriptor import RigDescriptor, particle_fits_cell, tilt_phases
 
 DESCRIPTOR = RigDescriptor(
     name="internal_friction", script="internal_friction.py",
@@ -9,4 +9,4 @@ DESCRIPTOR = RigDescriptor(
                      "lid_material"),
     procedure=POUR + TILT, phases=tilt_phases, result_keys=FRICTION_RESULT, responses=FRICTION_RESPONSES,
     check_job=particle_fits_cell, post="friction",
-    pictures=("friction_vs_stress.png",), trace=tilt_trace)
+    pictures=("friction_vs_stress.png",))

@@ -1,7 +1,7 @@
 """wall_friction: tilt-table wall friction (calibrates particle-steel friction). No
 replicas: gravity is rotated for the whole scene, replicas would share one tilt."""
 from ._cells import CELL, FRICTION_RESPONSES, FRICTION_RESULT, POUR, TILT
-from .descriptor import RigDescriptor, particle_fits_cell, tilt_phases, tilt_trace
+from .descriptor import RigDescriptor, particle_fits_cell, tilt_phases
 
 DESCRIPTOR = RigDescriptor(
     name="wall_friction", script="wall_friction.py",
@@ -9,4 +9,4 @@ DESCRIPTOR = RigDescriptor(
                      "plate_front_length_m", "plate_half_width_m", "lid_material"),
     procedure=POUR + TILT, phases=tilt_phases, result_keys=FRICTION_RESULT, responses=FRICTION_RESPONSES,
     check_job=particle_fits_cell, post="friction",
-    pictures=("friction_vs_stress.png",), trace=tilt_trace)
+    pictures=("friction_vs_stress.png",))
