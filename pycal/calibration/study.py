@@ -26,6 +26,7 @@ from ..stats import stopping
 from . import gallery, outputs, targets
 from .held import held_values
 from .provenance import study_provenance
+from .eta import Eta, text as eta_text
 from .verdicts import matches_lab
 from .journal import Journal, fingerprint
 from .names import format_params, group_label, unit_of_key
@@ -68,6 +69,8 @@ class Study:
         self.section = "study"       # what the runs are for now: '<material>/<stage>', 'validation/<name>' ...
         self.jobs = []               # every job asked: section, rig, seed, job id, status (outputs: jobs.csv)
         self.t0 = time.time()
+        self.eta = Eta(_workers_of(executor))
+        self.stage_budget = None      # (stage budget, runs requested before the stage, stage index) of the running stage
         self.provenance = study_provenance(self.config_path)
         self.journal = Journal(self.out / "journal.json")
         # every target now: a broken lab file stops the study before any run
@@ -105,6 +108,7 @@ class Study:
             out = self.executor.run(jobs, raise_on_error=False)
             errors = list(getattr(self.executor, "last_errors", []))
             self.record_jobs(jobs, out)
+            self.eta.add(rig, out)
             slots = [s for s in wanted if s not in results]
             retry = []
             for slot, seed, r in zip(slots, batch, out):
@@ -176,9 +180,28 @@ class Study:
                             "response": response.name, "mean": m, "std": s, "n": len(values),
                             "seeds": list(self.last_seeds)})
         shown = f"{m:.4g} +/- {s:.2g}" if scalar else f"{len(values)} vectors"
-        self.log(f"  {format_params(params)} -> {response.name} {shown} (n {len(values)}; study runs "
-                 f"{self.runs_requested}, {time.time() - self.t0:.0f} s)")
+        self.log(f"  {format_params(params)} -> {response.name} {shown} (n {len(values)}; {self.progress_text()})")
         return values
+
+    def progress_text(self):
+        """'stage 9/18, <= ~4 min; study <= ~35 min': runs of the stage / its budget, and the
+        time left at most in the stage and in the study's stages before the validation section
+        (pycal.calibration.eta: upper bounds from the CPU per run measured so far)."""
+        elapsed = f"{time.time() - self.t0:.0f} s"
+        if self.stage_budget is None:
+            return f"study runs {self.runs_requested}, {elapsed}"
+        budget, before, index = self.stage_budget
+        done = self.runs_requested - before
+        stages = [st for sts in self.cfg["materials"].values() for st in sts]
+
+        def rigs_of(st):
+            return [st["rig"]] if st.get("rig") else [r["rig"] for r in st.get("responses", [])]
+        here = [(r, (budget - done) / len(rigs_of(stages[index]))) for r in rigs_of(stages[index])]
+        later = [(r, st["max_runs_count"] / len(rigs_of(st))) for st in stages[index + 1:] if st["kind"] != "inherit"
+                 for r in rigs_of(st)]
+        stage_s, _ = self.eta.bound_s(here)
+        study_s, unknown = self.eta.bound_s(here + later)
+        return f"stage {done}/{budget}, <= {eta_text(stage_s, [])}; study <= {eta_text(study_s, unknown)}"
 
     def nearest_point_results(self, material, stage, rig, extra):
         """Results of the point run in this stage on `rig` nearest to `extra` (relative
@@ -299,6 +322,7 @@ class Study:
                 self.section = f"{material}/{st['label']}"
                 self.log(f"[stage {k}/{n_stages}] {material}: {st['label']}" + (f" on {rig}" if rig else ""))
                 held = held_values(self, material, st)
+                self.stage_budget = (st.get("max_runs_count", 0), self.runs_requested, k - 1)
                 if st["kind"] == "inherit":
                     row = self.stage_inherit(material, st)
                 else:
@@ -327,6 +351,7 @@ class Study:
                 if not row["parameters"]:
                     self.log(f"  -> not met: {row['message']}")
                 outputs.write_all(self)
+        self.stage_budget = None
         from . import run_at_check
         self.section = "run_at_check"
         run_at_check.run(self)                           # stages that ran at other values, at the calibrated ones
@@ -362,6 +387,15 @@ def failed_row(study, material, st, exc):
                            "target_source": t.source} for n, t in zip(names, tg)],
             "met": False, "stop_reason": "runs failed" if isinstance(exc, RunError) else stopping.STUDY_BUDGET,
             "message": str(exc), "points_count": 0}
+
+
+def _workers_of(executor):
+    """Parallel YADE processes of an executor (through wrappers), 1 when it does not say."""
+    while executor is not None:
+        if isinstance(getattr(executor, "workers", None), int):
+            return executor.workers
+        executor = getattr(executor, "inner", None)
+    return 1
 
 
 def cost_per_material(stage_rows):
