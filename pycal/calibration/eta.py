@@ -35,6 +35,6 @@ class Eta:
 
 
 def text(seconds, unknown):
-    """'~12 min' (+ ' + 2 rigs uncosted': rigs with no run so far)."""
+    """'~12 min', or '~12 min + ?' when stages on rigs with no run so far are to come."""
     out = f"~{seconds / 60:.0f} min" if seconds >= 60 else f"~{seconds:.0f} s"
-    return out + (f" + {len(unknown)} rig{'s' if len(unknown) > 1 else ''} uncosted" if unknown else "")
+    return out + (" + ?" if unknown else "")

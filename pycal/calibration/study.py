@@ -184,9 +184,9 @@ class Study:
         return values
 
     def progress_text(self):
-        """'stage 9/18, <= ~4 min; study <= ~35 min': runs of the stage / its budget, and the
-        time left at most in the stage and in the study's stages before the validation section
-        (pycal.calibration.eta: upper bounds from the CPU per run measured so far)."""
+        """'9/18 runs; left <= ~35 min': runs of the stage / its budget, and the time
+        left at most in the study's stages from here to the validation section
+        (pycal.calibration.eta: an upper bound from the CPU per run measured so far)."""
         elapsed = f"{time.time() - self.t0:.0f} s"
         if self.stage_budget is None:
             return f"study runs {self.runs_requested}, {elapsed}"
@@ -199,9 +199,8 @@ class Study:
         here = [(r, (budget - done) / len(rigs_of(stages[index]))) for r in rigs_of(stages[index])]
         later = [(r, st["max_runs_count"] / len(rigs_of(st))) for st in stages[index + 1:] if st["kind"] != "inherit"
                  for r in rigs_of(st)]
-        stage_s, _ = self.eta.bound_s(here)
         study_s, unknown = self.eta.bound_s(here + later)
-        return f"stage {done}/{budget}, <= {eta_text(stage_s, [])}; study <= {eta_text(study_s, unknown)}"
+        return f"{done}/{budget} runs; left <= {eta_text(study_s, unknown)}"
 
     def nearest_point_results(self, material, stage, rig, extra):
         """Results of the point run in this stage on `rig` nearest to `extra` (relative
