@@ -13,7 +13,7 @@ import json
 import math
 from pathlib import Path
 
-from .calibration.names import unit_label
+from .calibration.names import fmt3, format_params, unit_label
 from .calibration.study import cost_per_material
 from .files import write_text
 
@@ -29,10 +29,13 @@ img{max-width:100%;height:auto;border:1px solid #eee}details{margin:8px 0}pre{fo
 
 
 def _num(v, unit=""):
-    """A number for a table: 4 significant digits, its unit after it."""
+    """A number for a table: 3 significant digits (no exponent between 1e-3 and 1e6), its
+    unit after it."""
     if v is None or (isinstance(v, float) and not math.isfinite(v)):
         return "-"
-    text = f"{v:.4g}".replace("e+0", "e").replace("e+", "e").replace("e-0", "e-")
+    if isinstance(v, bool) or not isinstance(v, (int, float)):
+        return _esc(v)
+    text = fmt3(v)
     u = unit_label(unit) if unit else ""
     return text + (f" {u}" if u and u != "-" else "")
 
@@ -89,7 +92,19 @@ def _stage_table(stages):
     return "\n".join(rows)
 
 
-def _stage_detail(study_dir, s):
+def _points_table(points):
+    """The stage's points: parameter values, seeds, mean and seed SD of the response."""
+    if not points:
+        return ""
+    rows = "".join(
+        f"<tr><td>{_esc(format_params(p['parameters']))}</td><td>{_esc(p['rig'])}</td>"
+        f"<td class=num>{', '.join(str(x) for x in p.get('seeds') or [])}</td>"
+        f"<td class=num>{_num(p['mean'])}</td><td class=num>{_num(p['std'])}</td></tr>" for p in points)
+    return ("<details><summary>points run (in order)</summary><table><tr><th>point</th><th>rig</th><th>seeds</th>"
+            f"<th>mean response</th><th>seed SD</th></tr>{rows}</table></details>")
+
+
+def _stage_detail(study_dir, s, history=()):
     parts = [f"<h3>{_esc(s['material'])}: {_esc(s['stage'])}</h3>"]
     lines = []
     for r in s.get("responses") or []:
@@ -117,6 +132,7 @@ def _stage_detail(study_dir, s):
         if not (study_dir / f).is_file():
             raise FileNotFoundError(f"{study_dir / f}: a plot named in summary.json is missing")
         parts.append(_img(study_dir, f))
+    parts.append(_points_table([p for p in history if p["material"] == s["material"] and p["stage"] == s["stage"]]))
     return "\n".join(parts)
 
 
@@ -270,7 +286,7 @@ def write_report(study_dir):
         parts.append(f"<tr><td>{_esc(mat)}</td><td class=num>{c['runs_requested']}</td>"
                      f"<td class=num>{c['runs_simulated']}</td><td class=num>{c['elapsed_s']:.0f}</td></tr>")
     parts.append("</table><h2>Stages</h2>")
-    parts += [_stage_detail(study_dir, s) for s in stages if s["kind"] != "inherit"]
+    parts += [_stage_detail(study_dir, s, summary.get("history") or []) for s in stages if s["kind"] != "inherit"]
     parts += _run_at_checks(summary.get("run_at_checks") or [])
     parts += _validation(study_dir, summary.get("predicted") or [])
     parts += _application(study_dir, summary.get("applied") or [])

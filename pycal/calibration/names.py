@@ -70,3 +70,15 @@ def format_params(params):
 
 def _short(v):
     return f"{v:.4g}" if isinstance(v, (int, float)) and not isinstance(v, bool) else str(v)
+
+
+def fmt3(v):
+    """3 significant digits, no exponent between 1e-3 and 1e6 (3767 -> '3770', 0.26485 ->
+    '0.265', 1e8 -> '1e8'): one rule for every table and plot label."""
+    import math
+    if v is None or not isinstance(v, (int, float)) or isinstance(v, bool) or not math.isfinite(v):
+        return "-" if v is None or isinstance(v, float) else str(v)
+    if v != 0 and 1e-3 <= abs(v) < 1e6:
+        digits = 2 - int(math.floor(math.log10(abs(v))))
+        return f"{round(v, digits):.{max(digits, 0)}f}"
+    return f"{v:.3g}".replace("e+0", "e").replace("e+", "e").replace("e-0", "e-")

@@ -15,7 +15,7 @@ import numpy as np
 
 from ..plotting import pyplot, save_png
 from ..stats.inversion import target_factor_95
-from .names import unit_label
+from .names import fmt3, unit_label
 
 
 def _plt():
@@ -28,6 +28,25 @@ def _folder(study, material, label):
 
 def _rel(study, path):
     return str(Path(path).relative_to(study.out))
+
+
+def response_axis_label(response):
+    """'angle of repose, mean over the pile's sectors (deg)': the response's description
+    (pycal.post.responses) and its unit; its name when it has none."""
+    text = response.description if response.description and not response.description.startswith("result key") \
+        else response.name
+    return f"{text} ({response.unit_label})"
+
+
+def _x_axis(ax, scale, xs):
+    """A log axis only where the plotted range spans a decade or more (else linear: a log
+    axis over a factor 2 shows two ticks)."""
+    from matplotlib.ticker import LogLocator, ScalarFormatter
+    lo, hi = float(np.min(xs)), float(np.max(xs))
+    if scale.log and lo > 0 and hi / lo >= 10:
+        ax.set_xscale("log")
+        ax.xaxis.set_major_locator(LogLocator(base=10, subs=(1.0, 2.0, 5.0)))
+        ax.xaxis.set_major_formatter(ScalarFormatter())
 
 
 def stage_1d(study, material, st, row, scale, xs, ys, step, target, response):
@@ -43,8 +62,8 @@ def stage_1d(study, material, st, row, scale, xs, ys, step, target, response):
     fig, ax = plt.subplots(figsize=(7.5, 4.4))
     if target.band > 0:
         ax.axhspan(target.value - target.band, target.value + target.band, color="tab:green", alpha=0.18,
-                   label=f"lab target {target.value:.4g} +- {target.band:.3g}")
-    ax.axhline(target.value, color="tab:green", lw=1.2, label=None if target.band > 0 else f"target {target.value:.4g}")
+                   label=f"lab target {fmt3(target.value)} +- {fmt3(target.band)}")
+    ax.axhline(target.value, color="tab:green", lw=1.2, label=None if target.band > 0 else f"target {fmt3(target.value)}")
     if target.standard_error > 0:        # the target is itself a mean (a twin's): its own 95 % range
         half = target.standard_error * target_factor_95(target.standard_error_dof)
         n = target.standard_error_seeds_count
@@ -55,13 +74,12 @@ def stage_1d(study, material, st, row, scale, xs, ys, step, target, response):
                     label="fitted mean response, 95 % band")
     ax.plot(grid_x, mean, color="tab:blue", lw=1.5)
     ax.plot(xs, ys, "o", ms=4, color="k", alpha=0.6,
-            label=f"runs ({len(ys)}: every seed; seed noise sd {step.model.noise_sd:.3g})")
-    ax.axvspan(p["low"], p["high"], color="tab:red", alpha=0.15, label=f"95 % interval [{p['low']:.4g}, {p['high']:.4g}]")
-    ax.axvline(p["estimate"], color="tab:red", lw=1.5, label=f"chosen {p['estimate']:.4g}")
-    if scale.log:
-        ax.set_xscale("log")
+            label=f"runs ({len(ys)}: every seed; seed noise sd {fmt3(step.model.noise_sd)})")
+    ax.axvspan(p["low"], p["high"], color="tab:red", alpha=0.15, label=f"95 % interval [{fmt3(p['low'])}, {fmt3(p['high'])}]")
+    ax.axvline(p["estimate"], color="tab:red", lw=1.5, label=f"chosen {fmt3(p['estimate'])}")
+    _x_axis(ax, scale, grid_x)
     ax.set_xlabel(f"{p['label']} ({unit_label(p['unit'])})")
-    ax.set_ylabel(f"{response.name} ({response.unit_label})")
+    ax.set_ylabel(response_axis_label(response))
     verdict = "met" if row["met"] else "NOT met"
     ax.set_title(f"{material} {st['label']}: {verdict} - {row['stop_reason']}", fontsize=10)
     ax.legend(fontsize=7, loc="best")
@@ -109,7 +127,7 @@ def stage_joint(study, material, st, row, scales, X, Y, step, tgts, widths, resp
             ax.set_xscale("log")
         ax.set_xlabel(f"{p['label']} ({unit_label(p['unit'])})", fontsize=8)
         ax.set_ylabel("(response - target) / lab band" if j == 0 else "")
-        ax.set_title(f"{p['estimate']:.4g} [{p['low']:.4g}, {p['high']:.4g}]", fontsize=9)
+        ax.set_title(f"{fmt3(p['estimate'])} [{fmt3(p['low'])}, {fmt3(p['high'])}]", fontsize=9)
         if j == 0:
             ax.legend(fontsize=6, loc="best")
     ax = axes[-1]

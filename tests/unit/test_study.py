@@ -689,7 +689,7 @@ def test_report_shows_pictures_held_values_both_verdicts_and_provenance(tmp_path
     html = write_report(tmp_path / "out" / "twin").read_text()
     assert "<th>matches the lab</th><th>precise enough</th>" in html
     assert html.count("as the lab reads it") == 2          # the two AoR stages
-    assert html.count("held values (not fitted in this stage)") == 3
+    assert html.count("held values (not fitted in this stage)") == 3 and html.count("points run (in order)") == 3
     assert html.count("<figure") == 6                       # 3 per AoR stage; the fill writes no picture
     prov = html.split("<h2>Provenance</h2>")[1]
     for field in ("host:", "command:", "libraries:", "python 3", "sklearn", "emcee", "lab files:", "SHA-256",
