@@ -101,6 +101,12 @@ def _cmd_job(args):
               f"{shell_line(cmd)} 2>&1 | tee {shlex.quote(str(folder / 'yade.log'))}")
 
 
+def _cmd_export(args):
+    from .export.formats import export
+    for path in export(args.calibrated, args.material, args.format, args.out):
+        print(f"wrote {path}")
+
+
 def _cmd_analyse(args):
     from .lab_analysis import cli_analyse
     cli_analyse(args)
@@ -157,6 +163,13 @@ def build_parser():
     s.add_argument("--workers", type=int, default=None,
                    help="parallel YADE processes in the printed command (default: cores)")
     s.set_defaults(func=_cmd_batch_table)
+
+    s = sub.add_parser("export", help="write a calibrated material for another DEM code (conventions converted)")
+    s.add_argument("--calibrated", required=True, metavar="STUDY_DIR", help="a study's output folder")
+    s.add_argument("--material", required=True, help="a calibrated material of that study")
+    s.add_argument("--format", required=True, choices=["yaml", "liggghts", "rocky", "edem"])
+    s.add_argument("--out", required=True, help="folder to write into")
+    s.set_defaults(func=_cmd_export)
 
     s = sub.add_parser("analyse", help="lab analysis: moisture, densities, belt load, rolling "
                                        "resistance estimate, impact stress vs drop height")

@@ -70,7 +70,7 @@ class Study:
         self.jobs = []               # every job asked: section, rig, seed, job id, status (outputs: jobs.csv)
         self.t0 = time.time()
         self.eta = Eta(_workers_of(executor))
-        self.stage_budget = None      # (stage budget, runs requested before the stage, stage index) of the running stage
+        self.stage_budget = None      # the running stage: (budget, runs requested before it, its index)
         self.provenance = study_provenance(self.config_path)
         self.journal = Journal(self.out / "journal.json")
         # every target now: a broken lab file stops the study before any run
