@@ -13,6 +13,7 @@ from pathlib import Path
 from .. import rigs
 from ..replicas import result_folder
 from .names import format_params
+from .study_config import stage_rigs
 
 
 def _trace_of(rig):
@@ -69,12 +70,11 @@ def _nearest(study, material, label, rig, want):
 def stage_pictures(study, material, st, row):
     """[{'file': path relative to the study folder, 'caption': ...}] of the stage's gallery."""
     runs = runs_dir_of(study.executor)
-    rig_names = [st["rig"]] if st.get("rig") else [r["rig"] for r in st.get("responses", [])]
     out, seen = [], set()
     folder = study.out / "plots" / f"{material}-{st['label']}" / "gallery"
-    for rig in rig_names:
-        pictures = rigs.get(rig).pictures
-        if not (pictures or _trace_of(rig)) or runs is None:
+    for rig in stage_rigs(st):
+        pictures, trace = rigs.get(rig).pictures, _trace_of(rig)
+        if not (pictures or trace) or runs is None:
             continue
         for caption, want in _chosen_points(row):
             results, params = _nearest(study, material, st["label"], rig, want)
@@ -84,7 +84,6 @@ def stage_pictures(study, material, st, row):
             r = results[0]
             src = Path(result_folder(r, r["job"], runs))
             shown = format_params(params)
-            trace = _trace_of(rig)
             if trace is not None:
                 dest = folder / f"{rig}-{len(out):02d}-tilt_trace.png"
                 dest.parent.mkdir(parents=True, exist_ok=True)

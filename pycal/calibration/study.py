@@ -30,7 +30,7 @@ from .eta import Eta, text as eta_text
 from .verdicts import matches_lab
 from .journal import Journal, fingerprint
 from .names import format_params, group_label, unit_of_key
-from .study_config import load_study
+from .study_config import load_study, stage_rigs
 
 SEED_SCHEME = "fresh seeds at every point"   # in the stage fingerprint: journals of the old scheme start afresh
 
@@ -193,12 +193,9 @@ class Study:
         budget, before, index = self.stage_budget
         done = self.runs_requested - before
         stages = [st for sts in self.cfg["materials"].values() for st in sts]
-
-        def rigs_of(st):
-            return [st["rig"]] if st.get("rig") else [r["rig"] for r in st.get("responses", [])]
-        here = [(r, (budget - done) / len(rigs_of(stages[index]))) for r in rigs_of(stages[index])]
-        later = [(r, st["max_runs_count"] / len(rigs_of(st))) for st in stages[index + 1:] if st["kind"] != "inherit"
-                 for r in rigs_of(st)]
+        here = [(r, (budget - done) / len(stage_rigs(stages[index]))) for r in stage_rigs(stages[index])]
+        later = [(r, st["max_runs_count"] / len(stage_rigs(st))) for st in stages[index + 1:]
+                 if st["kind"] != "inherit" for r in stage_rigs(st)]
         study_s, unknown = self.eta.bound_s(here + later)
         return f"{done}/{budget} runs; left <= {eta_text(study_s, unknown)}"
 
@@ -317,7 +314,7 @@ class Study:
                 k += 1
                 t_stage, runs_before = time.time(), self.runs_requested
                 simulated_before = getattr(self.executor, "simulated_count", 0)
-                rig = st.get("rig") or ", ".join(r["rig"] for r in st.get("responses", []))
+                rig = ", ".join(stage_rigs(st))
                 self.section = f"{material}/{st['label']}"
                 self.log(f"[stage {k}/{n_stages}] {material}: {st['label']}" + (f" on {rig}" if rig else ""))
                 held = held_values(self, material, st)

@@ -346,3 +346,8 @@ def load_study(path):
         out["materials"][mat] = norm
     out["raw"] = data
     return out
+
+
+def stage_rigs(st):
+    """The rigs a normalized stage runs: its `rig`, or its responses' rigs (joint); [] for an inherit."""
+    return [st["rig"]] if st.get("rig") else [r["rig"] for r in st.get("responses", [])]
