@@ -163,15 +163,22 @@ def _aor_seeds(a):
     if not a or not a.get("seeds"):
         return ""
     head = ("<table><tr><th>seed</th><th>left</th><th>right</th><th>front</th><th>back</th><th>mean of the sides "
-            "with an angle</th><th>sides</th></tr>")
+            "with an angle</th><th>sides</th><th>doubtful flank fits (kept in the mean)</th></tr>")
+
+    def side(x, name):
+        flag = (x.get("flank_flags") or {}).get(name)
+        text = _num(x[f"aor_{name}_deg"], "deg")
+        return f"{text}?" if flag else text
+
     rows = "".join("<tr>" + "".join(f"<td class=num>{c}</td>" for c in (
-        x["seed"], _num(x["aor_left_deg"], "deg"), _num(x["aor_right_deg"], "deg"), _num(x["aor_front_deg"], "deg"),
-        _num(x["aor_back_deg"], "deg"), _num(x["aor_mean_deg"], "deg"), x.get("aor_sectors_count", "-"))) + "</tr>"
+        x["seed"], side(x, "left"), side(x, "right"), side(x, "front"), side(x, "back"),
+        _num(x["aor_mean_deg"], "deg"), x.get("aor_sectors_count", "-"))) + "<td>" + _esc(
+        "; ".join(f"{k}: {v}" for k, v in (x.get("flank_flags") or {}).items()) or "-") + "</td></tr>"
                    for x in a["seeds"])
     lab = a.get("lab")
     if lab:
         rows += (f"<tr><td>lab ({_esc(lab['sample'])})</td><td class=num>{_num(lab['left_deg'], 'deg')}</td>"
-                 f"<td class=num>{_num(lab['right_deg'], 'deg')}</td><td>-</td><td>-</td><td>-</td><td>-</td></tr>")
+                 f"<td class=num>{_num(lab['right_deg'], 'deg')}</td><td>-</td><td>-</td><td>-</td><td>-</td><td>-</td></tr>")
     at = a["point"]
     return (f"<details open><summary>the pile per seed at the point nearest the estimate ({_esc(at)}), "
             f"as the lab reads it</summary>{head}{rows}</table></details>")

@@ -108,10 +108,23 @@ def json_key(params):
 ANGLE_KEYS = ("aor_left_deg", "aor_right_deg", "aor_front_deg", "aor_back_deg", "aor_mean_deg", "aor_sectors_count")
 
 
+def _flank_flags(result, runs):
+    """{sector: reason} of a pile's doubtful flank fits (pycal.post.aor method step 7): from
+    result.json, or refitted from the run's pile_profile.csv for runs made before the flag."""
+    if "aor_flank_flags" in result:
+        return result["aor_flank_flags"] or {}
+    if runs is None:
+        return {}
+    from ..post import aor
+    profile = Path(result_folder(result, result["job"], runs)) / "pile_profile.csv"
+    return aor.flank_flags({"fits": aor.read_profile_fits(profile)}) if profile.is_file() else {}
+
+
 def aor_seed_angles(study, material, st, row):
     """The AoR as the lab reads it, at the point nearest the estimate: per seed the left,
-    right, front and back flank angles (deg, None: no angle on that side), their mean and
-    the sector count, and the lab's own left / right of the stage's target sample.
+    right, front and back flank angles (deg, None: no angle on that side), their mean, the
+    sector count and the doubtful flank fits, and the lab's own left / right of the
+    stage's target sample.
     {} for a stage that is not read from a pile."""
     reads = [(st["rig"], st.get("response"), st.get("target"))] if st.get("rig") else [
         (r["rig"], r["response"], r.get("target")) for r in st.get("responses") or []]
@@ -123,7 +136,9 @@ def aor_seed_angles(study, material, st, row):
     results, params = _nearest(study, material, st["label"], rig, points[0][1])
     if not results:
         return {}
-    seeds = [{"seed": r["seed"], **{k: r.get(k) for k in ANGLE_KEYS}} for r in results]
+    runs = runs_dir_of(study.executor)
+    seeds = [{"seed": r["seed"], **{k: r.get(k) for k in ANGLE_KEYS}, "flank_flags": _flank_flags(r, runs)}
+             for r in results]
     lab = None
     if target.get("sample"):
         from .. import LAB_DIR

@@ -40,7 +40,8 @@ def measure(rows, measure_cfg, table_z_m=0.0):
 
 def result_keys(whole, upper, prefix="aor"):
     """{aor_left_deg, ..., aor_mean_deg, aor_sectors_count, aor_upper_left_deg, ...,
-    aor_upper_mean_deg, aor_upper_sectors_count}: pycal.post.aor.result_keys of both."""
+    aor_upper_mean_deg, aor_upper_sectors_count, the flank flags of both}: pycal.post.aor.result_keys
+    of both."""
     return {**aor.result_keys(whole, prefix), **aor.result_keys(upper, f"{prefix}_upper")}
 
 

@@ -106,7 +106,8 @@ def test_result_keys():
     m = aor.measure_pile(cone(35.0), **CFG)
     keys = aor.result_keys(m, "surcharge")
     assert set(keys) == {"surcharge_left_deg", "surcharge_right_deg", "surcharge_front_deg",
-                         "surcharge_back_deg", "surcharge_mean_deg", "surcharge_sectors_count"}
+                         "surcharge_back_deg", "surcharge_mean_deg", "surcharge_sectors_count",
+                         "surcharge_flank_flags"}
     assert keys["surcharge_sectors_count"] == 4 and aor.missing_angles(m) == []
 
 
@@ -134,3 +135,58 @@ def test_particles_rolled_away_on_the_table_do_not_change_the_angle():
     b = aor.measure_pile(np.vstack([pile, strays]), **CFG)["angles"]
     for side in a:
         assert b[side] == pytest.approx(a[side], abs=1.0), side
+
+
+def _fit(points, z_lo, z_hi):
+    """fit_silhouette of [(z, r)] slice points with the slices z_lo..z_hi used."""
+    return aor.fit_silhouette(points, z_lo, z_hi)
+
+
+def test_a_regular_pile_has_no_doubtful_flank():
+    m = aor.measure_pile(cone(35.0), **CFG)
+    assert aor.flank_flags(m) == {}
+    assert aor.result_keys(m)["aor_flank_flags"] == {}
+
+
+def test_a_steep_fit_through_the_foot_of_a_shallow_silhouette_is_flagged():
+    """The report's case: a 30 deg silhouette (r = 0.2 - z / tan 30) whose two used
+    slices near the foot stand one above the other (a particle perched on the toe):
+    the fit reads 90 deg, the silhouette 30 deg."""
+    t = math.tan(math.radians(30.0))
+    pts = [(z, 0.2 - z / t) for z in (0.00625, 0.01875, 0.03125, 0.04375, 0.05625, 0.06875)]
+    pts[1] = (0.01875, 0.2 - 0.03125 / t)          # the 2nd slice's edge as far out as the 3rd's
+    fit = _fit(pts, 0.015, 0.035)                   # only slices 2 and 3 used
+    assert fit["n_used"] == 2 and fit["angle_deg"] == pytest.approx(90.0)
+    assert aor.silhouette_angle_deg(fit["points"]) == pytest.approx(30.0, abs=3.0)
+    why = aor.flank_problem(fit)
+    assert why.startswith("fit 90 deg through 2 slices") and "whole silhouette 3" in why
+
+
+def test_a_two_slice_fit_on_the_silhouette_is_not_flagged_and_a_far_one_with_more_is():
+    t = math.tan(math.radians(40.0))
+    line = [(z, 0.2 - z / t) for z in (0.00625, 0.01875, 0.03125, 0.04375, 0.05625)]
+    assert aor.flank_problem(_fit(line, 0.015, 0.035)) is None            # 2 slices, on the line
+    # 3 used slices 30 deg steeper than a 40 deg silhouette of 7 slices: flagged
+    steep = math.tan(math.radians(75.0))
+    pts = [(z, 0.2 - z / t) for z in (0.00625, 0.01875, 0.03125, 0.04375, 0.05625, 0.06875, 0.08125)]
+    pts[2:5] = [(z, pts[2][1] - (z - pts[2][0]) / steep) for z, _ in pts[2:5]]
+    fit = _fit(pts, 0.03, 0.06)
+    assert fit["n_used"] == 3 and fit["angle_deg"] == pytest.approx(75.0, abs=0.5)
+    assert "through 3 slices" in aor.flank_problem(fit)
+
+
+def test_the_profile_refit_reads_the_run_s_angles_and_the_side_view_marks_a_doubtful_flank(tmp_path):
+    pts = cone(35.0)
+    m = aor.measure_pile(pts, **CFG)
+    aor.write_profile_csv(m, tmp_path / "pile_profile.csv")
+    fits = aor.read_profile_fits(tmp_path / "pile_profile.csv")
+    for side in ("left", "right", "front", "back"):
+        assert fits[side]["angle_deg"] == pytest.approx(m["angles"][side], abs=1e-9)
+    # make the right flank doubtful: its fit vertical through two slices
+    f = m["fits"]["right"]
+    f["angle_deg"], f["n_used"] = 90.0, 2
+    fig = aor.pile_figure(pts, m)
+    styles = {l.get_label().split()[0]: l.get_linestyle() for l in fig.axes[0].lines
+              if l.get_label().startswith(("left", "right"))}
+    assert styles == {"left": "-", "right": "--"}
+    assert "right 90.0?" in fig.axes[0].get_title()
