@@ -166,7 +166,8 @@ def build_parser():
 
     s = sub.add_parser("export", help="write a calibrated material for another DEM code (conventions converted)")
     s.add_argument("--calibrated", required=True, metavar="STUDY_DIR", help="a study's output folder")
-    s.add_argument("--material", required=True, help="a calibrated material of that study")
+    s.add_argument("--material", required=True, help="a calibrated material of that study, or a material set "
+                                                     "(configs/material_sets/) with its components' calibrated values")
     s.add_argument("--format", required=True, choices=["yaml", "liggghts", "rocky", "edem"])
     s.add_argument("--out", required=True, help="folder to write into")
     s.set_defaults(func=_cmd_export)

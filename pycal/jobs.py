@@ -92,6 +92,40 @@ def resolve_job(rig, material, overrides=None, seed=1, config_dir=CONFIG_DIR):
     return _finish_job(rig, rig_cfg, seed, material, {material: mat}, overrides, config_dir)
 
 
+def resolve_set_materials(set_name, overrides=None, config_dir=CONFIG_DIR):
+    """(materials, set) of a material set with overrides ('<component>.<key>' -> that
+    material, any other key -> the set): every component material (in the set's order)
+    with the set's cross_interactions written into both materials of each pair, and the
+    validated set (components with mass_fraction; cross_interactions). No rig: the part of
+    resolve_set_job that `pycal export` shares."""
+    set_path = f"configs/{SET_DIR}/{set_name}.yaml"
+    raw = load_yaml(Path(config_dir) / SET_DIR / f"{set_name}.yaml")
+    known = {m: copy.deepcopy(load_material(m, config_dir)) for m in material_names(config_dir)}
+    comps = list(raw.get("components") or {}) if isinstance(raw.get("components"), dict) else []
+    overrides = dict(overrides or {})
+    set_keys = []
+    for key, value in overrides.items():
+        head = key.split(".", 1)[0]
+        if head in comps and "." in key:
+            _set_path(known[head], key.split(".", 1)[1], value, f"overrides of configs/materials/{head}.yaml")
+        else:
+            set_keys.append(key)
+    for key in set_keys:    # after the components': a set override wins over a from_components rule
+        _own_carried_key(raw, key, known)
+        _set_path(raw, key, overrides[key], f"overrides of {set_path}")
+    partners = set(material_names(config_dir)) | set(load_boundaries_cached(config_dir))
+    for m in comps:
+        if m in known:
+            validate_material(known[m], f"configs/materials/{m}.yaml (with overrides)", partners)
+    mset = validate_material_set(raw, f"{set_path} (with overrides)" if overrides else set_path, known)
+    materials = {m: known[m] for m in mset["components"]}
+    for a, pairs in mset["cross_interactions"].items():
+        for b, props in pairs.items():
+            materials[a]["interactions"][b] = copy.deepcopy(props)
+            materials[b]["interactions"][a] = copy.deepcopy(props)
+    return materials, mset
+
+
 def resolve_set_job(rig, set_name, overrides=None, seed=1, config_dir=CONFIG_DIR):
     """Job of a material set (configs/material_sets/<set_name>.yaml) on a rig that
     accepts sets (accepts_material_sets in its descriptor, pycal/rigs/<rig>.py).
@@ -109,34 +143,12 @@ def resolve_set_job(rig, set_name, overrides=None, seed=1, config_dir=CONFIG_DIR
         takers = [r for r in rig_names(config_dir) if r in rigs.names() and rigs.get(r).accepts_material_sets]
         raise ConfigError("--material", set_name, f"rig {rig} takes one material, and {set_name} is a material set "
                           f"(rigs that take sets: {', '.join(takers) or 'none'}; pycal/rigs/<rig>.py)")
-    set_path = f"configs/{SET_DIR}/{set_name}.yaml"
-    raw = load_yaml(Path(config_dir) / SET_DIR / f"{set_name}.yaml")
-    known = {m: copy.deepcopy(load_material(m, config_dir)) for m in material_names(config_dir)}
-    comps = list(raw.get("components") or {}) if isinstance(raw.get("components"), dict) else []
-    overrides = dict(overrides or {})
-    set_keys = []
-    for key, value in overrides.items():
-        head = key.split(".", 1)[0]
-        if key.startswith("rig."):
-            _set_path(rig_cfg, key[4:], value, f"overrides of configs/rigs/{rig}.yaml")
-        elif head in comps and "." in key:
-            _set_path(known[head], key.split(".", 1)[1], value, f"overrides of configs/materials/{head}.yaml")
-        else:
-            set_keys.append(key)
-    for key in set_keys:    # after the components': a set override wins over a from_components rule
-        _own_carried_key(raw, key, known)
-        _set_path(raw, key, overrides[key], f"overrides of {set_path}")
-    partners = set(material_names(config_dir)) | set(load_boundaries_cached(config_dir))
-    for m in comps:
-        if m in known:
-            validate_material(known[m], f"configs/materials/{m}.yaml (with overrides)", partners)
-    mset = validate_material_set(raw, f"{set_path} (with overrides)" if overrides else set_path, known)
-    check_rig_with_overrides(rig, rig_cfg, overrides, config_dir)
-    materials = {m: known[m] for m in mset["components"]}
-    for a, pairs in mset["cross_interactions"].items():
-        for b, props in pairs.items():
-            materials[a]["interactions"][b] = copy.deepcopy(props)
-            materials[b]["interactions"][a] = copy.deepcopy(props)
+    rig_overrides = {k: v for k, v in (overrides or {}).items() if k.startswith("rig.")}
+    for key, value in rig_overrides.items():
+        _set_path(rig_cfg, key[4:], value, f"overrides of configs/rigs/{rig}.yaml")
+    materials, mset = resolve_set_materials(set_name, {k: v for k, v in (overrides or {}).items()
+                                                       if not k.startswith("rig.")}, config_dir)
+    check_rig_with_overrides(rig, rig_cfg, dict(overrides or {}), config_dir)
     return _finish_job(rig, rig_cfg, seed, set_name, materials, overrides, config_dir, material_set=mset)
 
 

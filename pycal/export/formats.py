@@ -1,15 +1,19 @@
-"""The export formats of a calibrated material (`pycal export`): yaml (ours, with
-intervals and provenance), liggghts (an input fragment for LIGGGHTS-PUBLIC), rocky and
-edem (tables of the values each code's GUI asks for, each conversion named).
+"""The export formats of a calibrated material or material set (`pycal export`): yaml
+(ours, with intervals and provenance), liggghts (an input fragment for LIGGGHTS-PUBLIC),
+rocky and edem (tables of the values each code's GUI asks for, each conversion named).
 
-Only sphere materials are exported (a clump material's multisphere template is not
-written); a cohesion model another code does not have is one "not representable" line.
+A material set (configs/material_sets/, e.g. mixed-wet) is exported with every
+component's calibrated values and the set's cross pairs, as the study's validation runs
+use them. Sphere components are written in full; a clump component's contact values are
+written, its multisphere templates are not (one line says so and where its shapes are);
+a cohesion model another code does not have is one "not representable" line.
 """
 import shutil
+from dataclasses import dataclass, field
 from pathlib import Path
 
 from .. import CONFIG_DIR
-from ..configs import load_boundaries, load_numerics, load_yaml, validate_material
+from ..configs import load_boundaries, load_numerics, load_yaml, material_set_names, validate_material
 from ..errors import ConfigError
 from ..files import write_csv, write_text
 from . import conversions as cv
@@ -17,61 +21,114 @@ from . import conversions as cv
 FORMATS = ("yaml", "liggghts", "rocky", "edem")
 
 
-def load_calibrated(study_dir, material):
-    """(material config with the calibrated values, its calibration record or None)."""
+@dataclass
+class Exported:
+    """What is exported: one material (components = {name: config}) or a material set."""
+    name: str
+    components: dict                                 # {component: material config with calibrated values}
+    mass_fractions: dict                             # {component: mass fraction}; {name: 1.0} for a material
+    records: dict = field(default_factory=dict)      # {component: its calibration record}
+    material_set: dict = None                        # the resolved set (None for one material)
+
+    def pair(self, a, b):
+        """The interaction values of the pair (a, b), or None (two boundaries never touch)."""
+        for x, y in ((a, b), (b, a)):
+            if x in self.components and y in self.components[x]["interactions"]:
+                return self.components[x]["interactions"][y]
+        return None
+
+    def radius(self, name):
+        """Sphere radius (m) of a component; None for a clump component or a boundary."""
+        p = self.components[name]["particles"] if name in self.components else None
+        return 0.5 * p["diameter_m"] if p and p["shape"] == "sphere" else None
+
+    def spheres(self):
+        return [c for c in self.components if self.radius(c) is not None]
+
+
+def _record(folder, material):
+    path = folder / f"{material}.calibration.yaml"
+    return load_yaml(path) if path.is_file() else None
+
+
+def load_calibrated(study_dir, name):
+    """The Exported material or material set `name` of the study in study_dir."""
     folder = Path(study_dir) / "calibrated"
-    path = folder / f"{material}.yaml"
+    if name in material_set_names():
+        from ..calibration.calibrated import load_study_overrides, overrides_for_material
+        from ..jobs import resolve_set_materials
+        materials, mset = resolve_set_materials(name, overrides_for_material(load_study_overrides(study_dir), name))
+        records = {m: r for m in materials if (r := _record(folder, m)) is not None}
+        return Exported(name, materials, {m: c["mass_fraction"] for m, c in mset["components"].items()},
+                        records, mset)
+    path = folder / f"{name}.yaml"
     if not path.is_file():
         known = sorted(p.stem for p in folder.glob("*.yaml") if not p.stem.endswith(".calibration"))
-        raise ConfigError("--material", material, f"no calibrated/{material}.yaml in {study_dir} "
-                          f"(calibrated: {', '.join(known) or 'none'})")
+        raise ConfigError("--material", name, f"no calibrated/{name}.yaml in {study_dir} (calibrated: "
+                          f"{', '.join(known) or 'none'}; material sets: {', '.join(material_set_names())})")
     mat = load_yaml(path)
-    partners = set(load_boundaries()) | set(mat.get("interactions", {}))
-    validate_material(mat, path, partners)
-    record = folder / f"{material}.calibration.yaml"
-    return mat, (load_yaml(record) if record.is_file() else None)
+    validate_material(mat, path, set(load_boundaries()) | set(mat.get("interactions", {})))
+    record = _record(folder, name)
+    return Exported(name, {name: mat}, {name: 1.0}, {name: record} if record else {})
 
 
-def _sphere(mat, fmt):
-    p = mat["particles"]
-    if p["shape"] != "sphere":
-        raise ConfigError("--material", mat["name"], f"a {p['shape']} material: the {fmt} export writes spheres only")
-    return 0.5 * p["diameter_m"], p["density_kg_m3"]
+def _spheres_only(ex, fmt):
+    if not ex.spheres():
+        shape = next(iter(ex.components.values()))["particles"]["shape"]
+        raise ConfigError("--material", ex.name, f"a {shape} material: "
+                          f"the {fmt} export writes sphere materials (a set may hold clumps)")
 
 
-def _types(mat):
-    """[(name, E Pa, nu)] of the material and every boundary it has a pair with."""
+def _types(ex):
+    """[(name, E Pa, nu)] of every component and every boundary one of them has a pair with."""
     b = load_boundaries()
-    out = [(mat["name"], mat["contact"]["youngs_modulus_pa"], mat["contact"]["poisson_ratio"])]
-    out += [(n, b[n]["youngs_modulus_pa"], b[n]["poisson_ratio"]) for n in mat["interactions"] if n in b]
+    out = [(m, c["contact"]["youngs_modulus_pa"], c["contact"]["poisson_ratio"]) for m, c in ex.components.items()]
+    walls = [n for n in b if any(n in c["interactions"] for c in ex.components.values())]
+    return out + [(n, b[n]["youngs_modulus_pa"], b[n]["poisson_ratio"]) for n in walls]
+
+
+def _pairs(ex):
+    """[(a, b, values)] of every pair once: component-component, then component-boundary."""
+    out, seen = [], set()
+    for a, c in ex.components.items():
+        for b, props in c["interactions"].items():
+            if b in ex.components or b in load_boundaries():
+                if frozenset((a, b)) not in seen:
+                    seen.add(frozenset((a, b)))
+                    out.append((a, b, props))
     return out
 
 
-def _pair(mat, a, b):
-    """The interaction values of the pair (a, b); boundary-boundary pairs never touch."""
-    name = mat["name"]
-    other = b if a == name else a if b == name else None
-    return mat["interactions"][other] if other is not None else None
+def _clump_lines(ex):
+    return [f"{m}: a clump material (size classes and shapes in its configs/materials/{m}.yaml, "
+            f"{100 * ex.mass_fractions[m]:.3g} % of the mass): its multisphere templates are not written"
+            for m in ex.components if ex.radius(m) is None]
 
 
-def cohesion_lines(mat, code):
-    """What each pair's cohesion becomes in `code`: [(pair, text)]."""
-    radius, density = _sphere(mat, code)
+def cohesion_lines(ex, code):
+    """What each pair's cohesion becomes in `code`: [(pair, text)]. Our constant pull-off
+    is a fraction of the weight of the lighter sphere of the pair."""
     out = []
-    for partner, props in mat["interactions"].items():
+    for a, b, props in _pairs(ex):
         c = props["cohesion"]
         model = c["model"]
         if model == "none":
             continue
-        pair = f"{mat['name']}-{partner}"
+        pair = f"{a}-{b}"
         if model == "force_fraction":
+            spheres = [m for m in (a, b) if m in ex.components and ex.radius(m) is not None]
             f = c["force_fraction"]
-            force = cv.pull_off_force_n(f, radius, density)
-            text = {"rocky": f"adhesive model Constant, force fraction {f:g} of the particle's weight "
-                             f"({force:.3g} N on a {2 * radius:g} m particle): the same model",
-                    "liggghts": f"not representable: a constant pull-off of {force:.3g} N ({f:g} x the particle's "
+            if spheres:
+                force = min(cv.pull_off_force_n(f, ex.radius(m), ex.components[m]["particles"]["density_kg_m3"])
+                            for m in spheres)
+                what = f"{force:.3g} N"
+            else:
+                what = "a force"
+            text = {"rocky": f"adhesive model Constant, force fraction {f:g} of the lighter particle's weight "
+                             f"({what}): the same model",
+                    "liggghts": f"not representable: a constant pull-off of {what} ({f:g} x the lighter particle's "
                                 "weight); cohesion sjkr gives k x contact area, which grows with the overlap",
-                    "edem": f"not representable: a constant pull-off of {force:.3g} N ({f:g} x the particle's "
+                    "edem": f"not representable: a constant pull-off of {what} ({f:g} x the lighter particle's "
                             "weight); JKR grows with the contact radius"}[code]
         else:
             values = ", ".join(f"{k} {v}" for k, v in c.items() if k != "model")
@@ -80,50 +137,65 @@ def cohesion_lines(mat, code):
     return out
 
 
-def write_yaml(study_dir, mat, record, out):
-    """Our own format: the calibrated material config and its calibration record."""
+def write_yaml(study_dir, ex, out):
+    """Our own format: the calibrated material configs, their calibration records and,
+    for a set, the set with its resolved cross pairs."""
     out.mkdir(parents=True, exist_ok=True)
     src = Path(study_dir) / "calibrated"
-    files = [shutil.copyfile(src / f"{mat['name']}.yaml", out / f"{mat['name']}.yaml")]
-    if record is not None:
-        files.append(shutil.copyfile(src / f"{mat['name']}.calibration.yaml", out / f"{mat['name']}.calibration.yaml"))
-    return [Path(f) for f in files]
+    if ex.material_set is None:
+        files = [shutil.copyfile(src / f"{ex.name}.yaml", out / f"{ex.name}.yaml")]
+        if ex.records:
+            files.append(shutil.copyfile(src / f"{ex.name}.calibration.yaml", out / f"{ex.name}.calibration.yaml"))
+        return [Path(f) for f in files]
+    import yaml
+    doc = {"material_set": ex.name, "study": str(study_dir), "set": ex.material_set,
+           "components": ex.components, "calibration_records": ex.records}
+    return [write_text(out / f"{ex.name}.set.yaml", "# a material set as the study's validation runs use it: "
+                       "components with their calibrated values, the set's cross pairs resolved\n"
+                       + yaml.safe_dump(doc, sort_keys=False))]
 
 
-def write_liggghts(study_dir, mat, record, out):
-    """in.<material>.liggghts: atom style, Hertz with tangential history and epsd2 rolling
-    friction, property/global tables for every type pair, time step, particle template."""
-    radius, density = _sphere(mat, "liggghts")
-    types = _types(mat)
+def _provenance(ex):
+    r = next(iter(ex.records.values()), None) or {}
+    return r.get("study", "?"), r.get("git_commit", "?")
+
+
+def write_liggghts(study_dir, ex, out):
+    """in.<name>.liggghts: atom style, Hertz with tangential history and epsd2 rolling
+    friction, property/global tables for every type pair, time step, sphere templates (and
+    their mass fractions for a set)."""
+    _spheres_only(ex, "liggghts")
+    types = _types(ex)
     n = len(types)
     names = [t[0] for t in types]
 
     def table(key, value_of):
-        vals = []
-        for a in names:
-            for b in names:
-                v = value_of(a, b)
-                vals.append(f"{v:.6g}")
+        vals = [f"{value_of(a, b):.6g}" for a in names for b in names]
         return f"fix m_{key} all property/global {key} peratomtypepair {n} " + " ".join(vals)
 
-    def pair_value(field, wall_wall):
+    def pair_value(field_name, wall_wall):
         def f(a, b):
-            p = _pair(mat, a, b)
-            return wall_wall if p is None else p[field]
+            p = ex.pair(a, b)
+            return wall_wall if p is None else p[field_name]
         return f
 
     def rolling(a, b):
-        p = _pair(mat, a, b)
+        p = ex.pair(a, b)
         if p is None:
             return 0.0
-        on_wall = a != mat["name"] or b != mat["name"]
-        return cv.liggghts_rolling_coefficient(p["rolling_resistance_coefficient"], radius,
-                                               None if on_wall else radius)
+        ra, rb = (ex.radius(m) if m in ex.components else None for m in (a, b))
+        if ra is None and rb is None:
+            return p["rolling_resistance_coefficient"]
+        if ra is None or rb is None:   # a wall or a clump: the sphere's own radius in both conventions
+            return cv.liggghts_rolling_coefficient(p["rolling_resistance_coefficient"], ra or rb)
+        return cv.liggghts_rolling_coefficient(p["rolling_resistance_coefficient"], ra, rb)
 
     num = load_numerics(CONFIG_DIR)
-    dt = cv.hertz_timestep_s(radius, mat["contact"]["youngs_modulus_pa"], density, num["timestep_safety_factor"])
-    src = (record or {}).get("study", "?"), (record or {}).get("git_commit", "?")
-    lines = [f"# {mat['name']} calibrated by pycal (study {src[0]}, commit {src[1]}); SI units",
+    dt = min(cv.hertz_timestep_s(ex.radius(m), ex.components[m]["contact"]["youngs_modulus_pa"],
+                                 ex.components[m]["particles"]["density_kg_m3"], num["timestep_safety_factor"])
+             for m in ex.spheres())
+    study, commit = _provenance(ex)
+    lines = [f"# {ex.name} calibrated by pycal (study {study}, commit {commit}); SI units",
              "# atom types: " + ", ".join(f"{k + 1} = {t}" for k, t in enumerate(names)),
              "atom_style granular", "atom_modify map array", "communicate single vel yes", "units si",
              f"fix m_E all property/global youngsModulus peratomtype {' '.join(f'{t[1]:.6g}' for t in types)}",
@@ -135,54 +207,78 @@ def write_liggghts(study_dir, mat, record, out):
              table("coefficientRollingFriction", rolling),
              "pair_style gran model hertz tangential history rolling_friction epsd2",
              "pair_coeff * *",
-             f"timestep {dt:.4g}   # {num['timestep_safety_factor']:g} x R sqrt(rho / E), as our rigs",
-             f"fix pts all particletemplate/sphere 15485863 atom_type 1 density constant {density:.6g} "
-             f"radius constant {radius:.6g}"]
-    lines += [f"# cohesion {pair}: {text}" for pair, text in cohesion_lines(mat, "liggghts")]
+             f"timestep {dt:.4g}   # {num['timestep_safety_factor']:g} x R sqrt(rho / E) of the smallest sphere, "
+             "as our rigs"]
+    seeds = iter((15485863, 15485867, 32452843, 32452867, 49979687))
+    templates = []
+    for m in ex.spheres():
+        k = names.index(m) + 1
+        templates.append(f"pts{k}")
+        lines.append(f"fix pts{k} all particletemplate/sphere {next(seeds)} atom_type {k} density constant "
+                     f"{ex.components[m]['particles']['density_kg_m3']:.6g} radius constant {ex.radius(m):.6g}")
+    if ex.material_set is not None:
+        total = sum(ex.mass_fractions[m] for m in ex.spheres())
+        pairs = " ".join(f"{t} {ex.mass_fractions[m] / total:.6g}" for t, m in zip(templates, ex.spheres()))
+        lines.append("# mass fractions of the sphere components (a clump component's share left out, renormalised)")
+        lines.append(f"fix pdd all particledistribution/discrete 86028121 {len(templates)} {pairs}")
+    lines += [f"# {text}" for text in _clump_lines(ex)]
+    lines += [f"# cohesion {pair}: {text}" for pair, text in cohesion_lines(ex, "liggghts")]
     out.mkdir(parents=True, exist_ok=True)
-    return [write_text(out / f"in.{mat['name']}.liggghts", "\n".join(lines) + "\n")]
+    return [write_text(out / f"in.{ex.name}.liggghts", "\n".join(lines) + "\n")]
 
 
-def _table_rows(mat, code):
-    radius, density = _sphere(mat, code)
-    e, nu = mat["contact"]["youngs_modulus_pa"], mat["contact"]["poisson_ratio"]
-    rows = [("particle", "density", f"{density:.6g}", "kg/m3", "same"),
-            ("particle", "diameter", f"{2 * radius:.6g}", "m", "same")]
-    if code == "edem":
-        rows += [("particle", "shear modulus", f"{cv.shear_modulus_pa(e, nu):.6g}", "Pa", "G = E / (2 (1 + nu))"),
-                 ("particle", "Poisson's ratio", f"{nu:.6g}", "-", "same")]
-    else:
-        rows += [("particle", "Young's modulus (Hertzian)", f"{e:.6g}", "Pa", "same"),
-                 ("particle", "Poisson's ratio", f"{nu:.6g}", "-", "same")]
-    for partner, p in mat["interactions"].items():
-        pair = f"{mat['name']}-{partner}"
-        rolling = ("same (elastic-plastic, moment capped at mu_r R |Fn|, R the particle's radius: Rocky's type C)"
-                   if code == "rocky" else
-                   "same coefficient, but EDEM's rolling friction is a constant directional torque (no spring): "
-                   "check a pile")
+def _table_rows(ex, code):
+    rows = []
+    for m, mat in ex.components.items():
+        e, nu = mat["contact"]["youngs_modulus_pa"], mat["contact"]["poisson_ratio"]
+        p = mat["particles"]
+        rows.append((m, "density", f"{p['density_kg_m3']:.6g}", "kg/m3", "same"))
+        if ex.material_set is not None:
+            rows.append((m, "mass fraction of the sample", f"{ex.mass_fractions[m]:.6g}", "-", "same"))
+        if ex.radius(m) is not None:
+            rows.append((m, "diameter", f"{p['diameter_m']:.6g}", "m", "same"))
+        else:
+            rows.append((m, "shape", "clump", "", f"build the size classes and shapes of configs/materials/{m}.yaml "
+                                                  "in the code's particle editor"))
+        if code == "edem":
+            rows += [(m, "shear modulus", f"{cv.shear_modulus_pa(e, nu):.6g}", "Pa", "G = E / (2 (1 + nu))"),
+                     (m, "Poisson's ratio", f"{nu:.6g}", "-", "same")]
+        else:
+            rows += [(m, "Young's modulus (Hertzian)", f"{e:.6g}", "Pa", "same"),
+                     (m, "Poisson's ratio", f"{nu:.6g}", "-", "same")]
+    rolling = ("same (elastic-plastic, moment capped at mu_r R |Fn|, R the particle's radius: Rocky's type C)"
+               if code == "rocky" else
+               "same coefficient, but EDEM's rolling friction is a constant directional torque (no spring): "
+               "check a pile")
+    for a, b, p in _pairs(ex):
+        pair = f"{a}-{b}"
         rows += [(pair, "coefficient of restitution", f"{p['restitution_coefficient']:.6g}", "-", "same"),
                  (pair, "static friction", f"{p['friction_coefficient']:.6g}", "-", "same"),
                  (pair, "rolling resistance", f"{p['rolling_resistance_coefficient']:.6g}", "-", rolling)]
-    rows += [(pair, "cohesion", "", "", text) for pair, text in cohesion_lines(mat, code)]
-    rows.append(("time step", "Rayleigh time", f"{cv.rayleigh_time_s(radius, e, nu, density):.4g}", "s",
-                 "pi R sqrt(rho / G) / (0.1631 nu + 0.8766); choose the code's fraction of it"))
+    rows += [(pair, "cohesion", "", "", text) for pair, text in cohesion_lines(ex, code)]
+    for m in ex.spheres():
+        c = ex.components[m]
+        rows.append((m, "Rayleigh time", f"{cv.rayleigh_time_s(ex.radius(m), c['contact']['youngs_modulus_pa'], c['contact']['poisson_ratio'], c['particles']['density_kg_m3']):.4g}",
+                     "s", "pi R sqrt(rho / G) / (0.1631 nu + 0.8766); choose the code's fraction of the smallest"))
     return rows
 
 
-def write_table(study_dir, mat, record, out, code):
+def write_table(study_dir, ex, out, code):
+    _spheres_only(ex, code)
     out.mkdir(parents=True, exist_ok=True)
-    return [write_csv(out / f"{mat['name']}.{code}.csv", ["what", "input", "value", "unit", "conversion"],
-                      [list(r) for r in _table_rows(mat, code)])]
+    return [write_csv(out / f"{ex.name}.{code}.csv", ["what", "input", "value", "unit", "conversion"],
+                      [list(r) for r in _table_rows(ex, code)])]
 
 
-def export(study_dir, material, fmt, out):
-    """Write `material` of the study in `fmt` into folder `out`; returns the files."""
+def export(study_dir, name, fmt, out):
+    """Write the material or material set `name` of the study in `fmt` into folder `out`;
+    returns the files."""
     if fmt not in FORMATS:
         raise ConfigError("--format", fmt, f"must be one of {', '.join(FORMATS)}")
-    mat, record = load_calibrated(study_dir, material)
+    ex = load_calibrated(study_dir, name)
     out = Path(out)
     if fmt == "yaml":
-        return write_yaml(study_dir, mat, record, out)
+        return write_yaml(study_dir, ex, out)
     if fmt == "liggghts":
-        return write_liggghts(study_dir, mat, record, out)
-    return write_table(study_dir, mat, record, out, fmt)
+        return write_liggghts(study_dir, ex, out)
+    return write_table(study_dir, ex, out, fmt)

@@ -59,3 +59,60 @@ def test_a_clump_material_or_unknown_format_is_refused_in_one_line(study, tmp_pa
     assert main(args + ["--material", "M7", "--format", "yaml"]) == 2
     assert "no calibrated/M7.yaml" in capsys.readouterr().err
     assert not (tmp_path / "o").exists()
+
+
+@pytest.fixture
+def set_study(tmp_path):
+    """A study folder whose summary holds calibrated overrides of M2 and M3-wet."""
+    import json
+    d = tmp_path / "set_study"
+    (d / "calibrated").mkdir(parents=True)
+    overrides = {"M2": {"particles.density_kg_m3": 3700.0, "interactions.M2.rolling_resistance_coefficient": 0.2},
+                 "M3-wet": {"particles.density_kg_m3": 2700.0, "interactions.M3-wet.friction_coefficient": 0.31,
+                            "interactions.M3-wet.rolling_resistance_coefficient": 0.4}}
+    (d / "summary.json").write_text(json.dumps({"overrides": overrides}))
+    return d
+
+
+def test_a_material_set_is_written_with_its_components_calibrated_values_and_cross_pairs(set_study, tmp_path):
+    out = tmp_path / "out"
+    for fmt in ("yaml", "liggghts", "rocky", "edem"):
+        assert main(["export", "--calibrated", str(set_study), "--material", "mixed-wet", "--format", fmt,
+                     "--out", str(out)]) == 0
+    assert {p.name for p in out.iterdir()} == {"mixed-wet.set.yaml", "in.mixed-wet.liggghts", "mixed-wet.rocky.csv",
+                                               "mixed-wet.edem.csv"}
+    lig = (out / "in.mixed-wet.liggghts").read_text().splitlines()
+    types = next(l for l in lig if l.startswith("# atom types")).split(": ", 1)[1].split(", ")
+    names = [t.split(" = ")[1] for t in types]
+    assert names[:3] == ["M1", "M2", "M3-wet"] and "steel" in names and "pvc" in names
+
+    def pair(key, a, b):
+        line = next(l for l in lig if f"property/global {key} " in l)
+        vals = [float(v) for v in line.split("peratomtypepair")[1].split()[1:]]
+        return vals[names.index(a) * len(names) + names.index(b)]
+    # the gravel-fines pair takes the wet fines' calibrated friction (the set's from_components rule)
+    assert pair("coefficientFriction", "M2", "M3-wet") == pytest.approx(0.31)
+    assert pair("coefficientFriction", "M3-wet", "M2") == pytest.approx(0.31)
+    # and their rolling resistance, x2 between equal spheres; M2-M2 its own 0.2 x2
+    assert pair("coefficientRollingFriction", "M2", "M3-wet") == pytest.approx(0.8)
+    assert pair("coefficientRollingFriction", "M2", "M2") == pytest.approx(0.4)
+    # the sphere components' mass fractions, renormalised without the clumps: 32.5 / (32.5 + 37.3)
+    dist = next(l for l in lig if "particledistribution/discrete" in l).split()
+    assert float(dist[dist.index("pts2") + 1]) == pytest.approx(32.5 / 69.8, rel=1e-5)
+    assert float(dist[dist.index("pts3") + 1]) == pytest.approx(37.3 / 69.8, rel=1e-5)
+    dens = {l.split()[6]: float(l.split()[9]) for l in lig if "particletemplate/sphere" in l}
+    assert dens == {"2": 3700.0, "3": 2700.0}
+    assert any(l.startswith("# M1: a clump material") for l in lig)
+    rocky = (out / "mixed-wet.rocky.csv").read_text()
+    assert "M1,shape,clump" in rocky and "M2-M3-wet,static friction,0.31" in rocky
+    import yaml
+    doc = yaml.safe_load((out / "mixed-wet.set.yaml").read_text())
+    assert doc["components"]["M2"]["particles"]["density_kg_m3"] == 3700.0
+
+
+def test_a_set_without_a_study_summary_is_refused_in_one_line(study, tmp_path, capsys):
+    assert main(["export", "--calibrated", str(study), "--material", "mixed-wet", "--format", "yaml",
+                 "--out", str(tmp_path / "o")]) == 2
+    err = capsys.readouterr().err
+    assert "no summary.json" in err and len(err.strip().splitlines()) == 1
+    assert not (tmp_path / "o").exists()
