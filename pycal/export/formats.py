@@ -196,8 +196,12 @@ def write_liggghts(study_dir, ex, out):
              for m in ex.spheres())
     study, commit = _provenance(ex)
     lines = [f"# {ex.name} calibrated by pycal (study {study}, commit {commit}); SI units",
+             "# use: define the simulation box as 'region domain block ... units box', then 'include' this file;",
+             "# your walls (fix mesh/surface ... type N) take the wall's atom type below",
              "# atom types: " + ", ".join(f"{k + 1} = {t}" for k, t in enumerate(names)),
-             "atom_style granular", "atom_modify map array", "communicate single vel yes", "units si",
+             "atom_style granular", "atom_modify map array", "boundary f f f", "newton off",
+             "communicate single vel yes", "units si", f"create_box {n} domain",
+             "hard_particles yes   # the steel and PVC walls are stiffer than LIGGGHTS' 1e9 Pa check",
              f"fix m_E all property/global youngsModulus peratomtype {' '.join(f'{t[1]:.6g}' for t in types)}",
              f"fix m_nu all property/global poissonsRatio peratomtype {' '.join(f'{t[2]:.6g}' for t in types)}",
              table("coefficientRestitution", pair_value("restitution_coefficient", 0.5)),
@@ -216,11 +220,12 @@ def write_liggghts(study_dir, ex, out):
         templates.append(f"pts{k}")
         lines.append(f"fix pts{k} all particletemplate/sphere {next(seeds)} atom_type {k} density constant "
                      f"{ex.components[m]['particles']['density_kg_m3']:.6g} radius constant {ex.radius(m):.6g}")
+    total = sum(ex.mass_fractions[m] for m in ex.spheres())
+    pairs = " ".join(f"{t} {ex.mass_fractions[m] / total:.6g}" for t, m in zip(templates, ex.spheres()))
     if ex.material_set is not None:
-        total = sum(ex.mass_fractions[m] for m in ex.spheres())
-        pairs = " ".join(f"{t} {ex.mass_fractions[m] / total:.6g}" for t, m in zip(templates, ex.spheres()))
         lines.append("# mass fractions of the sphere components (a clump component's share left out, renormalised)")
-        lines.append(f"fix pdd all particledistribution/discrete 86028121 {len(templates)} {pairs}")
+    lines.append(f"fix pdd all particledistribution/discrete 86028121 {len(templates)} {pairs}   "
+                 "# for fix insert/pack or insert/stream: distributiontemplate pdd")
     lines += [f"# {text}" for text in _clump_lines(ex)]
     lines += [f"# cohesion {pair}: {text}" for pair, text in cohesion_lines(ex, "liggghts")]
     out.mkdir(parents=True, exist_ok=True)
