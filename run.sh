@@ -15,7 +15,8 @@ usage: ./run.sh COMMAND [ARGS]
                      configs/calibrations/); results and report under runs/
   test [PYTEST ARGS] run the test suite (unit layer + short YADE physics layer)
   pycal ARGS         same as /usr/bin/python3 -m pycal ARGS (./run.sh pycal --help lists them)
-  bench [NAME]       run the benchmarks in bench/ (figures go to bench/README.md by hand)
+  bench [NAME]       run the benchmarks in bench/ (figures go to bench/README.md by hand);
+                     bench liggghts_cross ARGS: the export checked in LIGGGHTS (installs liggghts)
   install            only install the dependencies
   --help             this text
 
@@ -61,6 +62,12 @@ case "$cmd" in
     ensure_deps
     exec "$PY" -m pycal calibrate "$@" ;;
   bench)
+    if [ "${1:-}" = "liggghts_cross" ]; then   # the cross-code check of the export: only it needs LIGGGHTS
+      shift
+      DEB_PACKAGES="$DEB_PACKAGES liggghts"
+      ensure_deps
+      exec "$PY" bench/liggghts_cross.py "$@"
+    fi
     ensure_deps
     exec "$PY" bench/run_bench.py "$@" ;;
   *) echo "run.sh: unknown command '$cmd'" >&2; usage >&2; exit 2 ;;
