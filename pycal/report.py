@@ -222,7 +222,31 @@ def _validation(study_dir, rows):
         parts += _sensitivity_section(study_dir, r)
         if r.get("plot") and (study_dir / r["plot"]).is_file():
             parts.append(_img(study_dir, r["plot"]))
+        parts.append(_seed_values(r))
+        parts.append(_gallery(study_dir, r.get("gallery")))
     return parts
+
+
+def _seed_values(r):
+    """A prediction's compared responses per seed beside the lab's values (a '?' marks a
+    doubtful flank fit, pycal/post/aor.py)."""
+    seeds = r.get("seed_values") or []
+    responses = [c["response"] for c in r.get("comparisons") or [] if any(c["response"] in x for x in seeds)]
+    if not seeds or not responses:
+        return ""
+
+    def cell(x, k):
+        side = k.replace("aor_", "").replace("_deg", "")
+        flag = (x.get("flank_flags") or {}).get(side)
+        return _num(x.get(k), "deg" if k.endswith("_deg") else "") + ("?" if flag else "")
+    labs = {c["response"]: c["lab"] for c in r["comparisons"]}
+    head = "".join(f"<th>{_esc(k)}</th>" for k in responses)
+    rows = "".join("<tr><td>" + str(x["seed"]) + "</td>" + "".join(f"<td class=num>{cell(x, k)}</td>" for k in responses)
+                   + "<td>" + _esc("; ".join(f"{k}: {v}" for k, v in (x.get("flank_flags") or {}).items()) or "-")
+                   + "</td></tr>" for x in seeds)
+    rows += "<tr><td>lab</td>" + "".join(f"<td class=num>{_num(labs.get(k))}</td>" for k in responses) + "<td>-</td></tr>"
+    return (f"<details><summary>{_esc(r['prediction'])} per seed</summary><table><tr><th>seed</th>{head}"
+            f"<th>doubtful flank fits</th></tr>{rows}</table></details>")
 
 
 def _run_at_checks(rows):

@@ -101,6 +101,41 @@ def stage_pictures(study, material, st, row):
     return out
 
 
+def prediction_pictures(study, name, rig, results, seeds_shown=3):
+    """[{'file', 'rig', 'caption'}] of a validation prediction: the pictures its rig writes
+    (e.g. the side view of the mixed pile with every sector's angle) for its first
+    seeds_shown seeds, copied into <study>/plots/validation-<name>/."""
+    runs = runs_dir_of(study.executor)
+    pictures = rigs.get(rig).pictures
+    if runs is None or not pictures:
+        return []
+    folder = study.out / "plots" / f"validation-{name}"
+    out = []
+    for r in results[:seeds_shown]:
+        src = Path(result_folder(r, r["job"], runs))
+        for pic in pictures:
+            if (src / pic).is_file():
+                dest = folder / f"seed{r['seed']}-{pic}"
+                dest.parent.mkdir(parents=True, exist_ok=True)
+                shutil.copyfile(src / pic, dest)
+                out.append({"file": str(dest.relative_to(study.out)), "rig": rig,
+                            "caption": f"{name}, seed {r['seed']}: {pic}"})
+    return out
+
+
+def seed_values(study, results, responses):
+    """Per seed the compared responses of a prediction (None: no value) and, for a pile,
+    its doubtful flank fits: [{'seed', response: value, ..., 'flank_flags'}]."""
+    runs = runs_dir_of(study.executor)
+    rows = []
+    for r in results:
+        row = {"seed": r["seed"], **{k: r.get(k) for k in responses if not isinstance(r.get(k), (list, dict))}}
+        if any(k.startswith("aor_") for k in responses):
+            row["flank_flags"] = _flank_flags(r, runs)
+        rows.append(row)
+    return rows
+
+
 def json_key(params):
     return json.dumps(params, sort_keys=True)
 

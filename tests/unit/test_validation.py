@@ -173,3 +173,24 @@ def test_a_leaf_override_does_not_write_into_the_callers_subtree():
         assert sub["force_fraction"] == 0.5
         job = resolve_job(rig, material, {prefix + k: v for k, v in calibrated.items()})
         assert job["materials"]["M3-wet"]["interactions"]["M3-wet"]["cohesion"]["force_fraction"] == 0.5
+
+
+def test_a_prediction_shows_its_piles_and_its_values_per_seed(tmp_path):
+    """The report's prediction section: the side views of its first 3 seeds (the rig's
+    pictures, copied from the job folders) and the compared response per seed beside the
+    lab's value."""
+    p = tmp_path / "val.yaml"
+    p.write_text(STUDY)
+    ex = FakeRigs(results={"surcharge": surcharge}, noise={"surcharge_mean_deg": 0.5}, runs_dir=tmp_path / "runs")
+    s = Study(p, ex, tmp_path / "out", log=lambda m: None)
+    s.run()
+    aor, sur = s.validation_rows
+    assert [g["file"] for g in aor["gallery"]] == [f"plots/validation-fines_dry_aor_left/seed{k}-pile_side.png"
+                                                    for k in aor["seeds"][:3]]
+    assert all((s.out / g["file"]).is_file() for g in aor["gallery"] + sur["gallery"])
+    assert [x["seed"] for x in aor["seed_values"]] == aor["seeds"]
+    mean = sum(x["aor_mean_deg"] for x in aor["seed_values"]) / len(aor["seed_values"])
+    assert mean == pytest.approx(aor["comparisons"][0]["sim_mean"])
+    from pycal.report import write_report
+    html = write_report(s.out).read_text()
+    assert "fines_dry_aor_left per seed" in html and "validation-fines_dry_aor_left/seed" in html
