@@ -168,7 +168,7 @@ def run_liggghts(folder, fragment, ex, material, rig_name, seed, num):
 def run_yade(study, material, rig_name, seeds, out):
     """The same rig in YADE through `pycal run` (cached: a job is its result)."""
     cmd = [sys.executable, "-m", "pycal", "run", rig_name, "--material", material, "--calibrated", str(study),
-           "--seeds", str(seeds), "--out", str(out)]
+           "--seeds", str(seeds), "--out", str(out), "--replicas", "1"]
     if rig_name == "aor":
         cmd += ["--set", f"rig.procedure.lift_speed_m_s={LIFT_SPEED_M_S}"]
     subprocess.run(cmd, cwd=REPO, check=True, capture_output=True, text=True)
