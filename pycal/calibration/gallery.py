@@ -12,6 +12,7 @@ from pathlib import Path
 
 from .. import rigs
 from ..replicas import result_folder
+from .run_pictures import flank_flags, runs_dir_of
 from .names import format_params
 from .study_config import stage_rigs
 
@@ -22,15 +23,6 @@ def _trace_of(rig):
     if not post:
         return None
     return getattr(importlib.import_module(f"pycal.post.{post}"), "trace_picture", None)
-
-
-def runs_dir_of(executor):
-    """The runs folder of an executor (through wrappers such as ReplicaExecutor), or None."""
-    while executor is not None:
-        if getattr(executor, "runs_dir", None) is not None:
-            return Path(executor.runs_dir)
-        executor = getattr(executor, "inner", None)
-    return None
 
 
 def _chosen_points(row):
@@ -101,58 +93,11 @@ def stage_pictures(study, material, st, row):
     return out
 
 
-def prediction_pictures(study, name, rig, results, seeds_shown=3):
-    """[{'file', 'rig', 'caption'}] of a validation prediction: the pictures its rig writes
-    (e.g. the side view of the mixed pile with every sector's angle) for its first
-    seeds_shown seeds, copied into <study>/plots/validation-<name>/."""
-    runs = runs_dir_of(study.executor)
-    pictures = rigs.get(rig).pictures
-    if runs is None or not pictures:
-        return []
-    folder = study.out / "plots" / f"validation-{name}"
-    out = []
-    for r in results[:seeds_shown]:
-        src = Path(result_folder(r, r["job"], runs))
-        for pic in pictures:
-            if (src / pic).is_file():
-                dest = folder / f"seed{r['seed']}-{pic}"
-                dest.parent.mkdir(parents=True, exist_ok=True)
-                shutil.copyfile(src / pic, dest)
-                out.append({"file": str(dest.relative_to(study.out)), "rig": rig,
-                            "caption": f"{name}, seed {r['seed']}: {pic}"})
-    return out
-
-
-def seed_values(study, results, responses):
-    """Per seed the compared responses of a prediction (None: no value) and, for a pile,
-    its doubtful flank fits: [{'seed', response: value, ..., 'flank_flags'}]."""
-    runs = runs_dir_of(study.executor)
-    rows = []
-    for r in results:
-        row = {"seed": r["seed"], **{k: r.get(k) for k in responses if not isinstance(r.get(k), (list, dict))}}
-        if any(k.startswith("aor_") for k in responses):
-            row["flank_flags"] = _flank_flags(r, runs)
-        rows.append(row)
-    return rows
-
-
 def json_key(params):
     return json.dumps(params, sort_keys=True)
 
 
 ANGLE_KEYS = ("aor_left_deg", "aor_right_deg", "aor_front_deg", "aor_back_deg", "aor_mean_deg", "aor_sectors_count")
-
-
-def _flank_flags(result, runs):
-    """{sector: reason} of a pile's doubtful flank fits (pycal.post.aor method step 7): from
-    result.json, or refitted from the run's pile_profile.csv for runs made before the flag."""
-    if "aor_flank_flags" in result:
-        return result["aor_flank_flags"] or {}
-    if runs is None:
-        return {}
-    from ..post import aor
-    profile = Path(result_folder(result, result["job"], runs)) / "pile_profile.csv"
-    return aor.flank_flags({"fits": aor.read_profile_fits(profile)}) if profile.is_file() else {}
 
 
 def aor_seed_angles(study, material, st, row):
@@ -172,7 +117,7 @@ def aor_seed_angles(study, material, st, row):
     if not results:
         return {}
     runs = runs_dir_of(study.executor)
-    seeds = [{"seed": r["seed"], **{k: r.get(k) for k in ANGLE_KEYS}, "flank_flags": _flank_flags(r, runs)}
+    seeds = [{"seed": r["seed"], **{k: r.get(k) for k in ANGLE_KEYS}, "flank_flags": flank_flags(r, runs)}
              for r in results]
     lab = None
     if target.get("sample"):

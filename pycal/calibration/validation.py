@@ -40,7 +40,7 @@ from ..post import compression as post_compression
 from ..post import lab_curves
 from ..plotting import new_figure, save_png
 from ..jobs import override_value, resolve_job
-from . import gallery
+from . import run_pictures
 from .calibrated import run_overrides
 
 CURVE = "ucs"   # compare: {response: ucs, lab: {curve: NAME}}: the result's curves against that lab curve
@@ -157,8 +157,8 @@ def run(study):
         row = {"prediction": pred["name"], "rig": pred["rig"], "material": pred["material"], "comparisons": comps,
                "seeds": list(study.last_seeds), "error": None,
                "plot": plot(study, pred["name"], comps),
-               "gallery": gallery.prediction_pictures(study, pred["name"], pred["rig"], results),
-               "seed_values": gallery.seed_values(study, results, [c["response"] for c in pred["compare"]])}
+               "gallery": run_pictures.prediction_pictures(study, pred["name"], pred["rig"], results),
+               "seed_values": run_pictures.seed_values(study, results, [c["response"] for c in pred["compare"]])}
         missed = [c for c, cmp in zip(comps, pred["compare"]) if not c["inside"]]
         if missed and pred.get("sensitivity"):
             # what drives the miss is its own command (pycal.calibration.sensitivity): not in the main job

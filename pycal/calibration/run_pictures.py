@@ -1,0 +1,65 @@
+"""The pictures and per-seed values of a set of runs for the report (pycal.calibration.
+gallery for the stages, pycal.calibration.validation for the predictions): where a run's
+folder is, a pile's doubtful flank fits, a prediction's pictures and values per seed.
+"""
+import shutil
+from pathlib import Path
+
+from .. import rigs
+from ..replicas import result_folder
+
+
+def runs_dir_of(executor):
+    """The runs folder of an executor (through wrappers such as ReplicaExecutor), or None."""
+    while executor is not None:
+        if getattr(executor, "runs_dir", None) is not None:
+            return Path(executor.runs_dir)
+        executor = getattr(executor, "inner", None)
+    return None
+
+
+def flank_flags(result, runs):
+    """{sector: reason} of a pile's doubtful flank fits (pycal.post.aor method step 7): from
+    result.json, or refitted from the run's pile_profile.csv for runs made before the flag."""
+    if "aor_flank_flags" in result:
+        return result["aor_flank_flags"] or {}
+    if runs is None:
+        return {}
+    from ..post import aor
+    profile = Path(result_folder(result, result["job"], runs)) / "pile_profile.csv"
+    return aor.flank_flags({"fits": aor.read_profile_fits(profile)}) if profile.is_file() else {}
+
+
+def prediction_pictures(study, name, rig, results, seeds_shown=3):
+    """[{'file', 'rig', 'caption'}] of a validation prediction: the pictures its rig writes
+    (e.g. the side view of the mixed pile with every sector's angle) for its first
+    seeds_shown seeds, copied into <study>/plots/validation-<name>/."""
+    runs = runs_dir_of(study.executor)
+    pictures = rigs.get(rig).pictures
+    if runs is None or not pictures:
+        return []
+    folder = study.out / "plots" / f"validation-{name}"
+    out = []
+    for r in results[:seeds_shown]:
+        src = Path(result_folder(r, r["job"], runs))
+        for pic in pictures:
+            if (src / pic).is_file():
+                dest = folder / f"seed{r['seed']}-{pic}"
+                dest.parent.mkdir(parents=True, exist_ok=True)
+                shutil.copyfile(src / pic, dest)
+                out.append({"file": str(dest.relative_to(study.out)), "rig": rig,
+                            "caption": f"{name}, seed {r['seed']}: {pic}"})
+    return out
+
+
+def seed_values(study, results, responses):
+    """Per seed the compared responses of a prediction (None: no value) and, for a pile,
+    its doubtful flank fits: [{'seed', response: value, ..., 'flank_flags'}]."""
+    runs = runs_dir_of(study.executor)
+    rows = []
+    for r in results:
+        row = {"seed": r["seed"], **{k: r.get(k) for k in responses if not isinstance(r.get(k), (list, dict))}}
+        if any(k.startswith("aor_") for k in responses):
+            row["flank_flags"] = flank_flags(r, runs)
+        rows.append(row)
+    return rows
