@@ -181,6 +181,28 @@ def run_yade(study, material, rig_name, seeds, out):
     return vals
 
 
+def variant_study(study, out, material, settings):
+    """A copy of the study's calibrated values of `material` with KEY=VALUE settings
+    applied in both places the two codes read them (summary.json overrides for YADE's
+    `pycal run --calibrated`, calibrated/<material>.yaml for the export): to find which
+    convention makes the codes differ (e.g. rolling resistance 0 in both)."""
+    import yaml
+    dst = Path(out) / "study"
+    (dst / "calibrated").mkdir(parents=True, exist_ok=True)
+    summ = json.loads((Path(study) / "summary.json").read_text())
+    mat = yaml.safe_load((Path(study) / "calibrated" / f"{material}.yaml").read_text())
+    for key, value in settings.items():
+        summ["overrides"].setdefault(material, {})[key] = value
+        node = mat
+        *head, last = key.split(".")
+        for k in head:
+            node = node[k]
+        node[last] = value
+    (dst / "summary.json").write_text(json.dumps({"overrides": summ["overrides"]}))
+    (dst / "calibrated" / f"{material}.yaml").write_text(yaml.safe_dump(mat, sort_keys=False))
+    return dst
+
+
 def summary(values):
     v = [x for x in values if x is not None and not math.isnan(x)]
     sd = statistics.stdev(v) if len(v) > 1 else float("nan")
@@ -194,21 +216,25 @@ def main(argv=None):
     ap.add_argument("--seeds", type=int, default=10)
     ap.add_argument("--out", default="runs/bench_liggghts")
     ap.add_argument("--rigs", nargs="+", default=["fill", "aor"])
+    ap.add_argument("--set", action="append", default=[], metavar="KEY=VALUE",
+                    help="a material key set in both codes (e.g. interactions.M2.rolling_resistance_coefficient=0)")
     args = ap.parse_args(argv)
     if shutil.which("liggghts") is None:
         sys.exit("liggghts not found: apt-get install liggghts (or ./run.sh bench liggghts_cross)")
     out = Path(args.out)
     num = load_numerics()
     table = []
+    settings = {k: float(v) for k, v in (item.split("=", 1) for item in args.set)}
     for material in args.material:
-        ex = load_calibrated(args.calibrated, material)
+        study = variant_study(args.calibrated, out / material, material, settings) if settings else args.calibrated
+        ex = load_calibrated(study, material)
         frag_dir = out / material / "export"
-        export(args.calibrated, material, "liggghts", frag_dir)
+        export(study, material, "liggghts", frag_dir)
         converted = (frag_dir / f"in.{material}.liggghts").read_text()
         variants = {"converted": converted, "naive": naive_fragment(converted, ex)}
         for rig in args.rigs:
             key = "aor_mean_deg" if rig == "aor" else "bulk_density_kg_m3"
-            yade = summary(run_yade(args.calibrated, material, rig, args.seeds, out / material / "yade"))
+            yade = summary(run_yade(study, material, rig, args.seeds, out / material / "yade"))
             row = {"material": material, "rig": rig, "quantity": key, "yade": yade}
             for name, frag in variants.items():
                 vals = []

@@ -7,12 +7,11 @@ copied into <study>/plots/<material>-<stage>/gallery/.
 import importlib
 import json
 import math
-import shutil
 from pathlib import Path
 
 from .. import rigs
 from ..replicas import result_folder
-from .run_pictures import flank_flags, runs_dir_of
+from .run_pictures import copy_pictures, flank_flags, runs_dir_of
 from .names import format_params
 from .study_config import stage_rigs
 
@@ -82,14 +81,8 @@ def stage_pictures(study, material, st, row):
                 if trace(src, r["job"], dest):
                     out.append({"file": str(dest.relative_to(study.out)), "rig": rig,
                                 "caption": f"{rig}, {caption} ({shown}), seed {r['seed']}: slide against tilt"})
-            for name in pictures:
-                if not (src / name).is_file():
-                    continue
-                dest = folder / f"{rig}-{len(out):02d}-{name}"
-                dest.parent.mkdir(parents=True, exist_ok=True)
-                shutil.copyfile(src / name, dest)
-                out.append({"file": str(dest.relative_to(study.out)), "rig": rig,
-                            "caption": f"{rig}, {caption} ({shown}), seed {r['seed']}: {name}"})
+            out += copy_pictures(study, src, pictures, rig, folder / f"{rig}-{len(out):02d}-",
+                                 f"{rig}, {caption} ({shown}), seed {r['seed']}: ")
     return out
 
 

@@ -30,6 +30,20 @@ def flank_flags(result, runs):
     return aor.flank_flags({"fits": aor.read_profile_fits(profile)}) if profile.is_file() else {}
 
 
+def copy_pictures(study, src, names, rig, prefix, caption):
+    """Copy the pictures `names` a run wrote into its folder `src` to <prefix><name>
+    (inside the study folder) for the report: [{'file': path relative to the study
+    folder, 'rig', 'caption': caption + name}] of those that exist."""
+    out = []
+    for name in names:
+        if (Path(src) / name).is_file():
+            dest = Path(f"{prefix}{name}")
+            dest.parent.mkdir(parents=True, exist_ok=True)
+            shutil.copyfile(Path(src) / name, dest)
+            out.append({"file": str(dest.relative_to(study.out)), "rig": rig, "caption": caption + name})
+    return out
+
+
 def prediction_pictures(study, name, rig, results, seeds_shown=3):
     """[{'file', 'rig', 'caption'}] of a validation prediction: the pictures its rig writes
     (e.g. the side view of the mixed pile with every sector's angle) for its first
@@ -41,14 +55,8 @@ def prediction_pictures(study, name, rig, results, seeds_shown=3):
     folder = study.out / "plots" / f"validation-{name}"
     out = []
     for r in results[:seeds_shown]:
-        src = Path(result_folder(r, r["job"], runs))
-        for pic in pictures:
-            if (src / pic).is_file():
-                dest = folder / f"seed{r['seed']}-{pic}"
-                dest.parent.mkdir(parents=True, exist_ok=True)
-                shutil.copyfile(src / pic, dest)
-                out.append({"file": str(dest.relative_to(study.out)), "rig": rig,
-                            "caption": f"{name}, seed {r['seed']}: {pic}"})
+        out += copy_pictures(study, result_folder(r, r["job"], runs), pictures, rig, folder / f"seed{r['seed']}-",
+                             f"{name}, seed {r['seed']}: ")
     return out
 
 
