@@ -1,0 +1,77 @@
+"""Rerun a study's own jobs with one setting changed, and compare seed by seed (a lever
+measured on exactly the runs a stage made).
+
+    /usr/bin/python3 bench/rerun_with.py RUNS_DIR --rig internal_friction --material M3-wet \
+        --set rig.procedure.tilt_rate_deg_s=5.0 --out runs/bench_wet_tilt [--seeds 1-6]
+
+Every job of RUNS_DIR/<rig>/<rig>-<material>-s<seed>-*/job.json is rebuilt from its
+recorded overrides (the rebuilt job id must equal the recorded one: the same job), run
+again with the --set overrides added, and compared: per run the stage responses
+`friction_angle_offset_deg` (friction rigs) or the result keys named by --response, the
+CPU seconds, and per group of equal overrides the paired difference and its standard
+error. Output: the table on stdout.
+"""
+import argparse
+import json
+import math
+import statistics
+import sys
+from pathlib import Path
+
+import yaml
+
+sys.path.insert(0, str(Path(__file__).resolve().parent.parent))
+from pycal.executors.local import LocalPool  # noqa: E402
+from pycal.jobs import resolve_job  # noqa: E402
+
+
+def rebuilt(job_file, extra):
+    """(the job rebuilt from job.json's overrides, the same job with `extra` added)."""
+    j = json.loads(Path(job_file).read_text())
+    same = resolve_job(j["rig"], j["material"], dict(j["overrides"]), seed=j["seed"])
+    if same["job_id"] != j["job_id"]:
+        raise SystemExit(f"{job_file}: rebuilt as {same['job_id']}, not the same job (configs changed since?)")
+    return same, resolve_job(j["rig"], j["material"], dict(j["overrides"], **extra), seed=j["seed"])
+
+
+def response(result, name):
+    if name == "friction_angle_offset_deg":
+        from pycal.post.friction import friction_angle_offset_deg
+        return friction_angle_offset_deg(result)
+    return result.get(name)
+
+
+def main(argv=None):
+    ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    ap.add_argument("runs")
+    ap.add_argument("--rig", required=True)
+    ap.add_argument("--material", required=True)
+    ap.add_argument("--set", action="append", required=True, metavar="KEY=VALUE")
+    ap.add_argument("--out", required=True)
+    ap.add_argument("--response", default="friction_angle_offset_deg")
+    ap.add_argument("--workers", type=int, default=2)
+    args = ap.parse_args(argv)
+    extra = {k: yaml.safe_load(v) for k, v in (s.split("=", 1) for s in args.set)}
+    files = sorted(Path(args.runs, args.rig).glob(f"{args.rig}-{args.material}-s*/job.json"))
+    pairs = [rebuilt(f, extra) for f in files]
+    before = LocalPool(runs_dir=args.runs, workers=1, progress=False).run([b for b, _ in pairs])   # cached
+    after = LocalPool(runs_dir=args.out, workers=args.workers).run([a for _, a in pairs])
+    groups = {}
+    for (b_job, _), b, a in zip(pairs, before, after):
+        rb, ra = response(b, args.response), response(a, args.response)
+        cb, ca = b["provenance"]["cpu_time_s"], a["provenance"]["cpu_time_s"]
+        key = json.dumps({k: v for k, v in b_job["overrides"].items() if not isinstance(v, (dict, list))},
+                         sort_keys=True)
+        groups.setdefault(key, []).append((rb, ra, cb, ca))
+        print(f"seed {b_job['seed']}: {args.response} {rb:.4g} -> {ra:.4g}; CPU {cb:.0f} -> {ca:.0f} s")
+    for key, rows in groups.items():
+        d = [ra - rb for rb, ra, _, _ in rows]
+        se = statistics.stdev(d) / math.sqrt(len(d)) if len(d) > 1 else math.nan
+        sd = statistics.stdev([r[0] for r in rows]) if len(rows) > 1 else math.nan
+        print(f"{key}\n  n {len(d)}: before {statistics.fmean(r[0] for r in rows):.4g} (seed SD {sd:.3g}), after "
+              f"{statistics.fmean(r[1] for r in rows):.4g}; paired difference {statistics.fmean(d):+.3g} +- {se:.2g}; "
+              f"CPU median {statistics.median(r[2] for r in rows):.0f} -> {statistics.median(r[3] for r in rows):.0f} s")
+
+
+if __name__ == "__main__":
+    main()
