@@ -69,7 +69,7 @@ class Study:
         self.section = "study"       # what the runs are for now: '<material>/<stage>', 'validation/<name>' ...
         self.jobs = []               # every job asked: section, rig, seed, job id, status (outputs: jobs.csv)
         self.t0 = time.time()
-        self.eta = Eta(_workers_of(executor))
+        self.eta = Eta(_workers_of(executor), cores=_local_cores(executor))
         self.stage_budget = None      # the running stage: (budget, runs requested before it, its index)
         self.provenance = study_provenance(self.config_path)
         self.journal = Journal(self.out / "journal.json")
@@ -108,7 +108,7 @@ class Study:
             out = self.executor.run(jobs, raise_on_error=False)
             errors = list(getattr(self.executor, "last_errors", []))
             self.record_jobs(jobs, out)
-            self.eta.add(rig, out)
+            self.eta.add(material, rig, out)
             slots = [s for s in wanted if s not in results]
             retry = []
             for slot, seed, r in zip(slots, batch, out):
@@ -192,9 +192,10 @@ class Study:
             return f"study runs {self.runs_requested}, {elapsed}"
         budget, before, index = self.stage_budget
         done = self.runs_requested - before
-        stages = [st for sts in self.cfg["materials"].values() for st in sts]
-        here = [(r, (budget - done) / len(stage_rigs(stages[index]))) for r in stage_rigs(stages[index])]
-        later = [(r, st["max_runs_count"] / len(stage_rigs(st))) for st in stages[index + 1:]
+        stages = [(m, st) for m, sts in self.cfg["materials"].items() for st in sts]
+        m_here, st_here = stages[index]
+        here = [(m_here, r, (budget - done) / len(stage_rigs(st_here))) for r in stage_rigs(st_here)]
+        later = [(m, r, st["max_runs_count"] / len(stage_rigs(st))) for m, st in stages[index + 1:]
                  if st["kind"] != "inherit" for r in stage_rigs(st)]
         study_s, unknown = self.eta.bound_s(here + later)
         return f"{done}/{budget} runs; left <= {eta_text(study_s, unknown)}"
@@ -383,6 +384,17 @@ def failed_row(study, material, st, exc):
                            "target_source": t.source} for n, t in zip(names, tg)],
             "met": False, "stop_reason": "runs failed" if isinstance(exc, RunError) else stopping.STUDY_BUDGET,
             "message": str(exc), "points_count": 0}
+
+
+def _local_cores(executor):
+    """This machine's cores when the runs go to local processes (through wrappers), else None."""
+    import os
+    from ..executors.local import LocalPool
+    while executor is not None:
+        if isinstance(executor, LocalPool):
+            return os.cpu_count()
+        executor = getattr(executor, "inner", None)
+    return None
 
 
 def _workers_of(executor):

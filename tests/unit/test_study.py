@@ -717,10 +717,26 @@ def test_calibrated_files_say_which_values_were_calibrated_with_intervals_and_wh
 def test_eta_is_an_upper_bound_from_the_cpu_per_run_so_far():
     from pycal.calibration.eta import Eta, text
     e = Eta(workers=2)
-    e.add("aor", [{"provenance": {"cpu_time_s": 10.0}}, {"provenance": {"cpu_time_s": 14.0}}, None])
-    seconds, unknown = e.bound_s([("aor", 6), ("wall_friction", 9)])
+    e.add("M2", "aor", [{"provenance": {"cpu_time_s": 10.0}}, {"provenance": {"cpu_time_s": 14.0}}, None])
+    seconds, unknown = e.bound_s([("M2", "aor", 6), ("M2", "wall_friction", 9)])
     assert seconds == pytest.approx(6 * 12.0 / 2) and unknown == ["wall_friction"]
     assert text(seconds, unknown) == "~36 s + ?" and text(600, []) == "~10 min"
+
+
+def test_eta_keeps_each_material_s_cost_on_a_rig_and_counts_only_the_cores():
+    """The main job's wet cohesion stage: the dry fines' internal-friction runs cost 110 s,
+    the wet ones 570 s; 15 wet runs left on 3 workers and 2 cores are ~71 min, not the 9
+    min that a rig-wide median over 3 workers gave. A material not run yet on a rig takes
+    the costliest material's cost there."""
+    from pycal.calibration.eta import Eta
+    e = Eta(workers=3, cores=2)
+    e.add("M3-dry", "internal_friction", [{"provenance": {"cpu_time_s": 110.0}}] * 15)
+    e.add("M3-wet", "internal_friction", [{"provenance": {"cpu_time_s": c}} for c in (517.0, 571.0, 644.0)])
+    seconds, _ = e.bound_s([("M3-wet", "internal_friction", 15)])
+    assert seconds == pytest.approx(15 * 571.0 / 2)
+    seconds, _ = e.bound_s([("M9", "internal_friction", 2)])
+    assert seconds == pytest.approx(2 * 571.0 / 2)
+    assert Eta(workers=3).workers == 3 and Eta(workers=3, cores=8).workers == 3
 
 
 def test_the_console_shows_stage_runs_and_time_left(tmp_path, study_file):
