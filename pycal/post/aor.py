@@ -33,6 +33,16 @@ Method - the pile's silhouette, as a gauge laid on the flank sees it
    sectors of 114 local M2 / M3-dry piles: the median difference is 6 deg, 10 % exceed
    20 deg (e.g. a 90 deg fit through the foot of a 24 deg silhouette); 103 fits rest on
    2 slices; the rule flags 46 (11 %).
+
+Why not the highest particle top in radial bins (the first version): with ~70 spheres
+of 25 mm a bin often holds only a particle hidden under its neighbours or a stray one
+on the table, the fit mixed the plateau with strays, and the angle fell when the
+rolling resistance rose (M2, 3 seeds: 23.7 +- 11 deg at eta 0.35, 17.1 +- 4.9 at 0.71).
+The silhouette on the same piles: 57.3 +- 7.2 and 66.6 +- 5.8, rising with eta.
+
+Known limits: the centre is the mass centre, not the apex, so on an asymmetric pile
+it moves towards the flatter side; a pile of ~4 layers of 25 mm spheres gives only
+~4-6 silhouette points per sector: angles are noisy, repeat seeds.
 """
 import math
 
@@ -255,7 +265,7 @@ def pile_figure(positions, fits, title=None, centre=None):
         f = fits.get(name)
         if f and f.get("line"):
             (r0, z0), (r1, z1) = f["line"]
-            flag = f" - doubtful: silhouette {flags[name].rsplit(' ', 2)[1]} deg" if name in flags else ""
+            flag = f" - doubtful: silhouette {silhouette_angle_deg(f['points']):.0f} deg" if name in flags else ""
             ax.plot([cx + sign * r0, cx + sign * r1], [z0, z1], color=colour, lw=2,
                     ls="--" if flag else "-", label=f"{name} {f['angle_deg']:.1f} deg{flag}")
             pts = [(rr, zz) for rr, zz, u in f["points"]]
