@@ -89,10 +89,10 @@ def _types(ex):
 
 def _pairs(ex):
     """[(a, b, values)] of every pair once: component-component, then component-boundary."""
-    out, seen = [], set()
+    out, seen, walls = [], set(), load_boundaries()
     for a, c in ex.components.items():
         for b, props in c["interactions"].items():
-            if b in ex.components or b in load_boundaries():
+            if b in ex.components or b in walls:
                 if frozenset((a, b)) not in seen:
                     seen.add(frozenset((a, b)))
                     out.append((a, b, props))
@@ -116,7 +116,7 @@ def cohesion_lines(ex, code):
             continue
         pair = f"{a}-{b}"
         if model == "force_fraction":
-            spheres = [m for m in (a, b) if m in ex.components and ex.radius(m) is not None]
+            spheres = [m for m in (a, b) if ex.radius(m) is not None]
             f = c["force_fraction"]
             if spheres:
                 force = min(cv.pull_off_force_n(f, ex.radius(m), ex.components[m]["particles"]["density_kg_m3"])
@@ -183,10 +183,8 @@ def write_liggghts(study_dir, ex, out):
         p = ex.pair(a, b)
         if p is None:
             return 0.0
-        ra, rb = (ex.radius(m) if m in ex.components else None for m in (a, b))
-        if ra is None and rb is None:
-            return p["rolling_resistance_coefficient"]
-        if ra is None or rb is None:   # a wall or a clump: the sphere's own radius in both conventions
+        ra, rb = ex.radius(a), ex.radius(b)
+        if ra is None or rb is None:   # a wall or a clump: the coefficient as on a wall (the sphere's own radius)
             return cv.liggghts_rolling_coefficient(p["rolling_resistance_coefficient"], ra or rb)
         return cv.liggghts_rolling_coefficient(p["rolling_resistance_coefficient"], ra, rb)
 
@@ -262,9 +260,11 @@ def _table_rows(ex, code):
                  (pair, "rolling resistance", f"{p['rolling_resistance_coefficient']:.6g}", "-", rolling)]
     rows += [(pair, "cohesion", "", "", text) for pair, text in cohesion_lines(ex, code)]
     for m in ex.spheres():
-        c = ex.components[m]
-        rows.append((m, "Rayleigh time", f"{cv.rayleigh_time_s(ex.radius(m), c['contact']['youngs_modulus_pa'], c['contact']['poisson_ratio'], c['particles']['density_kg_m3']):.4g}",
-                     "s", "pi R sqrt(rho / G) / (0.1631 nu + 0.8766); choose the code's fraction of the smallest"))
+        c = ex.components[m]["contact"]
+        t = cv.rayleigh_time_s(ex.radius(m), c["youngs_modulus_pa"], c["poisson_ratio"],
+                               ex.components[m]["particles"]["density_kg_m3"])
+        rows.append((m, "Rayleigh time", f"{t:.4g}", "s",
+                     "pi R sqrt(rho / G) / (0.1631 nu + 0.8766); choose the code's fraction of the smallest"))
     return rows
 
 
