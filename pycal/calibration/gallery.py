@@ -11,7 +11,7 @@ from pathlib import Path
 
 from .. import rigs
 from ..replicas import result_folder
-from .run_pictures import copy_pictures, flank_flags, runs_dir_of
+from .run_pictures import copy_pictures, run_flank_flags, runs_dir_of
 from .names import format_params
 from .study_config import stage_rigs
 
@@ -110,7 +110,7 @@ def aor_seed_angles(study, material, st, row):
     if not results:
         return {}
     runs = runs_dir_of(study.executor)
-    seeds = [{"seed": r["seed"], **{k: r.get(k) for k in ANGLE_KEYS}, "flank_flags": flank_flags(r, runs)}
+    seeds = [{"seed": r["seed"], **{k: r.get(k) for k in ANGLE_KEYS}, "flank_flags": run_flank_flags(r, runs)}
              for r in results]
     lab = None
     if target.get("sample"):

@@ -6,19 +6,16 @@ import shutil
 from pathlib import Path
 
 from .. import rigs
+from ..executors.base import wrapped_chain
 from ..replicas import result_folder
 
 
 def runs_dir_of(executor):
     """The runs folder of an executor (through wrappers such as ReplicaExecutor), or None."""
-    while executor is not None:
-        if getattr(executor, "runs_dir", None) is not None:
-            return Path(executor.runs_dir)
-        executor = getattr(executor, "inner", None)
-    return None
+    return next((Path(e.runs_dir) for e in wrapped_chain(executor) if getattr(e, "runs_dir", None) is not None), None)
 
 
-def flank_flags(result, runs):
+def run_flank_flags(result, runs):
     """{sector: reason} of a pile's doubtful flank fits (pycal.post.aor method step 7): from
     result.json, or refitted from the run's pile_profile.csv for runs made before the flag."""
     if "aor_flank_flags" in result:
@@ -68,6 +65,6 @@ def seed_values(study, results, responses):
     for r in results:
         row = {"seed": r["seed"], **{k: r.get(k) for k in responses if not isinstance(r.get(k), (list, dict))}}
         if any(k.startswith("aor_") for k in responses):
-            row["flank_flags"] = flank_flags(r, runs)
+            row["flank_flags"] = run_flank_flags(r, runs)
         rows.append(row)
     return rows

@@ -18,6 +18,7 @@ import time
 from pathlib import Path
 
 from ..configs import load_material
+from ..executors.base import wrapped_chain
 from ..errors import BudgetSpent, PycalError, RunError  # noqa: F401 (BudgetSpent: callers catch it here)
 from ..jobs import resolve_job
 from ..post import mean_std
@@ -390,20 +391,12 @@ def _local_cores(executor):
     """This machine's cores when the runs go to local processes (through wrappers), else None."""
     import os
     from ..executors.local import LocalPool
-    while executor is not None:
-        if isinstance(executor, LocalPool):
-            return os.cpu_count()
-        executor = getattr(executor, "inner", None)
-    return None
+    return os.cpu_count() if any(isinstance(e, LocalPool) for e in wrapped_chain(executor)) else None
 
 
 def _workers_of(executor):
     """Parallel YADE processes of an executor (through wrappers), 1 when it does not say."""
-    while executor is not None:
-        if isinstance(getattr(executor, "workers", None), int):
-            return executor.workers
-        executor = getattr(executor, "inner", None)
-    return 1
+    return next((e.workers for e in wrapped_chain(executor) if isinstance(getattr(e, "workers", None), int)), 1)
 
 
 def cost_per_material(stage_rows):

@@ -13,6 +13,14 @@ from ..errors import RunError
 from .jobdirs import DEFAULT_RUNS_DIR, cached_failure, cached_result, clean_stale_temporaries
 
 
+def wrapped_chain(executor):
+    """The executor and the ones it wraps (`.inner`, e.g. a ReplicaExecutor around a
+    LocalPool), outermost first."""
+    while executor is not None:
+        yield executor
+        executor = getattr(executor, "inner", None)
+
+
 def say(msg):
     print(msg, file=sys.stderr, flush=True)
 
