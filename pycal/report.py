@@ -157,6 +157,19 @@ def _gallery(study_dir, pictures):
     return f"<details open><summary>simulated samples</summary>{cells}</details>"
 
 
+def _angle_cell(x, key):
+    """A seed's value of `key` for a table (3 significant digits, deg for a *_deg key),
+    with '?' when the run flagged that side's flank fit as doubtful (x['flank_flags'],
+    pycal/post/aor.py)."""
+    flag = (x.get("flank_flags") or {}).get(key.replace("aor_", "").replace("_deg", ""))
+    return _num(x.get(key), "deg" if key.endswith("_deg") else "") + ("?" if flag else "")
+
+
+def _flags_cell(x):
+    """A seed's doubtful flank fits as text, '-' for none."""
+    return _esc("; ".join(f"{k}: {v}" for k, v in (x.get("flank_flags") or {}).items()) or "-")
+
+
 def _aor_seeds(a):
     """The pile as the lab reads it: per seed left / right / front / back at the point nearest
     the estimate, and the lab's left / right."""
@@ -164,16 +177,9 @@ def _aor_seeds(a):
         return ""
     head = ("<table><tr><th>seed</th><th>left</th><th>right</th><th>front</th><th>back</th><th>mean of the sides "
             "with an angle</th><th>sides</th><th>doubtful flank fits (kept in the mean)</th></tr>")
-
-    def side(x, name):
-        flag = (x.get("flank_flags") or {}).get(name)
-        text = _num(x[f"aor_{name}_deg"], "deg")
-        return f"{text}?" if flag else text
-
     rows = "".join("<tr>" + "".join(f"<td class=num>{c}</td>" for c in (
-        x["seed"], side(x, "left"), side(x, "right"), side(x, "front"), side(x, "back"),
-        _num(x["aor_mean_deg"], "deg"), x.get("aor_sectors_count", "-"))) + "<td>" + _esc(
-        "; ".join(f"{k}: {v}" for k, v in (x.get("flank_flags") or {}).items()) or "-") + "</td></tr>"
+        x["seed"], *(_angle_cell(x, f"aor_{side}_deg") for side in ("left", "right", "front", "back")),
+        _num(x["aor_mean_deg"], "deg"), x.get("aor_sectors_count", "-"))) + f"<td>{_flags_cell(x)}</td></tr>"
                    for x in a["seeds"])
     lab = a.get("lab")
     if lab:
@@ -234,16 +240,10 @@ def _seed_values(r):
     responses = [c["response"] for c in r.get("comparisons") or [] if any(c["response"] in x for x in seeds)]
     if not seeds or not responses:
         return ""
-
-    def cell(x, k):
-        side = k.replace("aor_", "").replace("_deg", "")
-        flag = (x.get("flank_flags") or {}).get(side)
-        return _num(x.get(k), "deg" if k.endswith("_deg") else "") + ("?" if flag else "")
     labs = {c["response"]: c["lab"] for c in r["comparisons"]}
     head = "".join(f"<th>{_esc(k)}</th>" for k in responses)
-    rows = "".join("<tr><td>" + str(x["seed"]) + "</td>" + "".join(f"<td class=num>{cell(x, k)}</td>" for k in responses)
-                   + "<td>" + _esc("; ".join(f"{k}: {v}" for k, v in (x.get("flank_flags") or {}).items()) or "-")
-                   + "</td></tr>" for x in seeds)
+    rows = "".join(f"<tr><td>{x['seed']}</td>" + "".join(f"<td class=num>{_angle_cell(x, k)}</td>" for k in responses)
+                   + f"<td>{_flags_cell(x)}</td></tr>" for x in seeds)
     rows += "<tr><td>lab</td>" + "".join(f"<td class=num>{_num(labs.get(k))}</td>" for k in responses) + "<td>-</td></tr>"
     return (f"<details><summary>{_esc(r['prediction'])} per seed</summary><table><tr><th>seed</th>{head}"
             f"<th>doubtful flank fits</th></tr>{rows}</table></details>")
