@@ -143,12 +143,15 @@ def resolve_set_job(rig, set_name, overrides=None, seed=1, config_dir=CONFIG_DIR
         takers = [r for r in rig_names(config_dir) if r in rigs.names() and rigs.get(r).accepts_material_sets]
         raise ConfigError("--material", set_name, f"rig {rig} takes one material, and {set_name} is a material set "
                           f"(rigs that take sets: {', '.join(takers) or 'none'}; pycal/rigs/<rig>.py)")
-    rig_overrides = {k: v for k, v in (overrides or {}).items() if k.startswith("rig.")}
-    for key, value in rig_overrides.items():
-        _set_path(rig_cfg, key[4:], value, f"overrides of configs/rigs/{rig}.yaml")
-    materials, mset = resolve_set_materials(set_name, {k: v for k, v in (overrides or {}).items()
-                                                       if not k.startswith("rig.")}, config_dir)
-    check_rig_with_overrides(rig, rig_cfg, dict(overrides or {}), config_dir)
+    overrides = dict(overrides or {})      # the job records {} for no overrides (its id depends on it)
+    material_overrides = {}
+    for key, value in overrides.items():
+        if key.startswith("rig."):
+            _set_path(rig_cfg, key[4:], value, f"overrides of configs/rigs/{rig}.yaml")
+        else:
+            material_overrides[key] = value
+    materials, mset = resolve_set_materials(set_name, material_overrides, config_dir)
+    check_rig_with_overrides(rig, rig_cfg, overrides, config_dir)
     return _finish_job(rig, rig_cfg, seed, set_name, materials, overrides, config_dir, material_set=mset)
 
 

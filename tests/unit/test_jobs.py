@@ -46,3 +46,14 @@ def test_parse_set():
     assert parse_set(["a.b=1", "c=2.5e6", "d={model: none}"]) == {"a.b": 1, "c": 2.5e6, "d": {"model": "none"}}
     with pytest.raises(ConfigError, match="KEY=VALUE"):
         parse_set(["novalue"])
+
+
+def test_a_set_job_without_overrides_is_the_job_with_none():
+    """No overrides and an empty dict are the same set job (the job records {}), called
+    directly or through resolve_job: a cached mixed-pile run is found again whichever way
+    the caller says it."""
+    from pycal.jobs import resolve_set_job
+    a = resolve_set_job("aor_mixed", "mixed-wet", None, seed=2)
+    b = resolve_set_job("aor_mixed", "mixed-wet", {}, seed=2)
+    assert a == resolve_job("aor_mixed", "mixed-wet", None, seed=2)
+    assert a == b and a["overrides"] == {}
