@@ -75,11 +75,17 @@ def square_triangles(half, z):
     return [(a, b, c), (a, c, d)]
 
 
+def atom_types(fragment):
+    """{name: LIGGGHTS atom type} from the export's '# atom types: 1 = M2, 2 = steel' line."""
+    listed = re.search(r"# atom types: (.*)", fragment).group(1)
+    return {t.split(" = ")[1]: int(t.split(" = ")[0]) for t in listed.split(", ")}
+
+
 def naive_fragment(text, ex):
     """The exported fragment with the rolling coefficients copied as they are (no radius
     convention converted): the 'naive' copy the conversions are measured against."""
-    names = re.search(r"# atom types: (.*)", text).group(1)
-    names = [t.split(" = ")[1] for t in names.split(", ")]
+    types = atom_types(text)
+    names = sorted(types, key=types.get)
 
     def raw(a, b):
         p = ex.pair(a, b)
@@ -98,7 +104,7 @@ def deck(fragment_file, types, rig, mat_diameter_m, seed, num, pile, dt_s):
     ke_ratio = num["rest_kinetic_energy_ratio"]
     chunk = 2000
     max_chunks = int(num["max_settle_time_s"] / (dt_s * chunk)) + 1
-    seeds = [prime_at_or_above(100003 + 7919 * (3 * seed + k)) for k in range(3)]
+    insert_seed = prime_at_or_above(100003 + 7919 * 3 * seed)
 
     def settle(tag):
         return [f"variable n_{tag} loop {max_chunks}", f"label loop_{tag}", f"run {chunk}",
@@ -113,7 +119,7 @@ def deck(fragment_file, types, rig, mat_diameter_m, seed, num, pile, dt_s):
              "fix walls all wall/gran model hertz tangential history rolling_friction epsd2 mesh n_meshes 2 "
              "meshes table cyl",
              f"region pour cylinder z 0 0 {0.5 * d - 1.01 * r:.6g} 0 {column:.6g} units box",
-             f"fix ins all insert/pack seed {seeds[0]} distributiontemplate pdd insert_every once "
+             f"fix ins all insert/pack seed {insert_seed} distributiontemplate pdd insert_every once "
              f"overlapcheck yes all_in yes volumefraction_region {1.0 - p['pour_porosity_ratio']:.6g} region pour",
              "fix integr all nve/sphere", "thermo 20000", "run 1"]
     lines += settle("pour")
@@ -140,11 +146,10 @@ def run_liggghts(folder, fragment, ex, material, rig_name, seed, num):
     g = rig["geometry"]
     folder.mkdir(parents=True, exist_ok=True)
     (folder / "material.liggghts").write_text(fragment)
-    names = re.search(r"# atom types: (.*)", fragment).group(1)
-    types = {t.split(" = ")[1]: int(t.split(" = ")[0]) for t in names.split(", ")}
+    types = atom_types(fragment)
     column = rig["procedure"]["pour_height_factor"] * g["cell_height_m"]
     dia = ex.components[material]["particles"]["diameter_m"]
-    stl(folder / "cyl.stl", cylinder_triangles(0.5 * g["cell_inner_diameter_m"], 0.0, column + dia, 
+    stl(folder / "cyl.stl", cylinder_triangles(0.5 * g["cell_inner_diameter_m"], 0.0, column + dia,
                                                g["cell_facet_segments_count"]))
     stl(folder / "table.stl", square_triangles(g.get("table_radius_m", 0.5 * g["cell_inner_diameter_m"] + 0.05), 0.0))
     dt = float(re.search(r"^timestep (\S+)", fragment, re.M).group(1))
