@@ -2,9 +2,9 @@
 measured on exactly the runs a stage made).
 
     /usr/bin/python3 bench/rerun_with.py RUNS_DIR --rig internal_friction --material M3-wet \
-        --set rig.procedure.tilt_rate_deg_s=5.0 --out runs/bench_wet_tilt [--seeds 1-6]
+        --set rig.procedure.tilt_rate_deg_s=5.0 --out runs/bench_wet_tilt
 
-Every job of RUNS_DIR/<rig>/<rig>-<material>-s<seed>-*/job.json is rebuilt from its
+Every job of RUNS_DIR/<rig>/<rig>-<material>-s<seed>-*/job.json (every seed there) is rebuilt from its
 recorded overrides (the rebuilt job id must equal the recorded one: the same job), run
 again with the --set overrides added, and compared: per run the stage responses
 `friction_angle_offset_deg` (friction rigs) or the result keys named by --response, the
