@@ -39,12 +39,16 @@ def parse_set(items):
     return out
 
 
-def _set_path(tree, dotted, value, where):
-    """Replace an existing key addressed by a dotted path; new keys are errors."""
+def _set_path(tree, dotted, value, where, may_add=()):
+    """Replace an existing key addressed by a dotted path; new keys are errors, except the
+    dotted paths in may_add (a rig's optional keys, which a config may leave out)."""
     parts = dotted.split(".")
     node = tree
     for i, part in enumerate(parts):
         last = i == len(parts) - 1
+        if last and isinstance(node, dict) and dotted in may_add:
+            node[part] = value
+            return
         if not isinstance(node, dict) or part not in node:
             raise ConfigError(where, dotted, f"no such key to override ({'.'.join(parts[:i + 1])})")
         if last:
@@ -82,7 +86,7 @@ def resolve_job(rig, material, overrides=None, seed=1, config_dir=CONFIG_DIR):
     mat = copy.deepcopy(load_material(material, config_dir))
     for key, value in overrides.items():
         if key.startswith("rig."):
-            _set_path(rig_cfg, key[4:], value, f"overrides of configs/rigs/{rig}.yaml")
+            _set_path(rig_cfg, key[4:], value, f"overrides of configs/rigs/{rig}.yaml", rigs.get(rig).optional)
         else:
             _set_path(mat, key, value, f"overrides of configs/materials/{material}.yaml")
     partners = set(material_names(config_dir)) | set(load_boundaries_cached(config_dir))
@@ -147,7 +151,7 @@ def resolve_set_job(rig, set_name, overrides=None, seed=1, config_dir=CONFIG_DIR
     material_overrides = {}
     for key, value in overrides.items():
         if key.startswith("rig."):
-            _set_path(rig_cfg, key[4:], value, f"overrides of configs/rigs/{rig}.yaml")
+            _set_path(rig_cfg, key[4:], value, f"overrides of configs/rigs/{rig}.yaml", rigs.get(rig).optional)
         else:
             material_overrides[key] = value
     materials, mset = resolve_set_materials(set_name, material_overrides, config_dir)

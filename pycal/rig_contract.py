@@ -37,3 +37,16 @@ def seed_job(batch_job, seed):
     job["seed"] = seed
     job["job_id"] = f"{batch_job['job_id']}-s{seed}"
     return job
+
+
+# ---------------------------------------------------------------- optional rig keys
+# Keys a rig config may leave out, with the value the rig uses then (the rig as it always ran:
+# leaving them out keeps the job ids). The tilt-table options of the internal-friction audit:
+# the sliding cell's rotations during the tilt, and the lid joined to the cell or free on the
+# contents (docs/rigs.md, "internal_friction").
+TILT_OPTION_DEFAULTS = {"sliding_cell_rotations": "blocked", "lid_during_tilt": "joined"}
+
+
+def tilt_option(procedure, key):
+    """procedure[key], or its default when the config left it out."""
+    return procedure.get(key, TILT_OPTION_DEFAULTS[key])

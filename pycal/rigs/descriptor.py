@@ -110,3 +110,18 @@ def particle_fits_cell(job):
             where = "--set" if overridden else f"configs/rigs/{job['rig']}.yaml"
             raise ConfigError(where, f"geometry.{key}", f"{g[key]:g} m does not hold one particle of "
                               f"{job['material']} ({size:g} m)")
+
+
+def tilt_options_need_fresh_fill(job):
+    """A ConfigError when procedure.sliding_cell_rotations: free or lid_during_tilt: free is
+    asked of a sequential fill: a cell that tipped, or a lid that slid off with the contents,
+    is not put back for the next step (only fill_each_step: fresh starts each step anew)."""
+    from ..errors import ConfigError
+    from ..rig_contract import TILT_OPTION_DEFAULTS, tilt_option
+    p = job["rig_config"]["procedure"]
+    for key, default in TILT_OPTION_DEFAULTS.items():
+        if tilt_option(p, key) != default and p["fill_each_step"] != "fresh":
+            overridden = f"rig.procedure.{key}" in (job.get("overrides") or {})
+            where = "--set" if overridden else f"configs/rigs/{job['rig']}.yaml"
+            raise ConfigError(where, f"procedure.{key}", f"{p[key]!r} needs procedure.fill_each_step: fresh "
+                              "(the cell or lid is not put back between steps)")

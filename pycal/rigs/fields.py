@@ -103,6 +103,8 @@ FIELDS = {
     "max_tilt_deg": Field("number", 0.0, 90.0, lo_open=True, reason="a tilt between flat and vertical"),
     "record_interval_s": TIME,
     "particle_damping_during_tilt": Field("choice", choices=("damped", "undamped", "undamped_when_sliding")),
+    "sliding_cell_rotations": Field("choice", choices=("blocked", "free")),
+    "lid_during_tilt": Field("choice", choices=("joined", "free")),
     "vibration_frequency_hz": positive("a frequency"),
     "vibration_amplitude_horizontal_m": non_negative(),
     "vibration_amplitude_vertical_m": non_negative(),

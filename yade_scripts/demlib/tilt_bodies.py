@@ -5,7 +5,7 @@
   configured mass and thin-walled-tube inertia;
 - Lid: the steel lid (loading.add_plate facets): servo plate while loading, free dead
   weight once unloaded; join()/split() make cell + lid one rigid body for the tilt and
-  separate them again for the next load;
+  separate them again for the next load (or Lid.free() leaves it free on the contents);
 - set_damped, stop_all, force_sum: small helpers on body ids.
 """
 from yade import O, utils, geom
@@ -48,13 +48,22 @@ class RigidBody:
     def bottom_z(self):
         return O.bodies[self.ref].state.pos[2] + self.ref_to_bottom
 
-    def hold(self, hold=True):
+    def hold(self, hold=True, rotations_free=False):
         """Fix it in place (all six DOFs) or release its translations (rotations stay
-        blocked: the cell and lid are guided, they do not tip)."""
+        blocked: the cell and lid are guided, they do not tip; rotations_free releases
+        them too, and the slide is then read at the body's centre of mass)."""
         st = O.bodies[self.id].state
         st.vel = Vector3(0, 0, 0)
         st.angVel = Vector3(0, 0, 0)
-        st.blockedDOFs = "xyzXYZ" if hold else "XYZ"
+        st.blockedDOFs = "xyzXYZ" if hold else ("" if rotations_free else "XYZ")
+        self.rotations_free = rotations_free and not hold
+
+    def slide_point(self):
+        """Where the slide is read (m): the reference member while the body only translates
+        (as the rig has always read it), the centre of mass once it may also turn."""
+        if getattr(self, "rotations_free", False):
+            return O.bodies[self.id].state.pos
+        return self.pos
 
     def lift_bottom_to(self, z):
         """Move the (held) body vertically so that its lowest edge is at z."""
@@ -145,6 +154,13 @@ class Lid:
             st = O.bodies[self.id].state
             st.vel = Vector3(0, 0, 0)
             st.blockedDOFs = "xyXYZ"
+
+    def free(self):
+        """The rigid lid free on the contents (translations x, y, z; not damped; it stays
+        level): the lid_during_tilt: free option, instead of join()."""
+        st = O.bodies[self.id].state
+        st.blockedDOFs = "XYZ"
+        st.isDamped = False
 
     def make_kinematic(self):
         """Rigid clump (or freed members) -> fixed kinematic facets at rest (for the servo)."""

@@ -6,7 +6,8 @@ displacement is simply the x displacement of the rigid cell.
 
 tilt_test() runs the phases in order:
 1. free the cell: the lid is joined to it (one rigid body hanging on the contents) and
-   it translates freely (rotations blocked); with procedure.settle_before_tilt it first
+   it translates freely (rotations blocked; procedure.lid_during_tilt and
+   sliding_cell_rotations: free change either, for the internal-friction audit); with procedure.settle_before_tilt it first
    comes to rest at zero tilt (its drift is recorded, the slide is measured from there);
 2. static friction: tilt (at pre_tilt_rate_deg_s until the cell has slid
    pre_tilt_slide_fraction of the onset distance, then at the lab's tilt_rate_deg_s)
@@ -29,6 +30,7 @@ from .phase_clock import CLOCK
 from .phases import drive
 from .tilt_bodies import force_sum, join, set_damped, split, stop_all
 from pycal.post.friction import DYNAMIC_MAX_ANGLE_DEG  # pure Python: one rule for rig and post
+from pycal.rig_contract import tilt_option
 
 DAMPING_MODES = ("damped", "undamped", "undamped_when_sliding")
 
@@ -74,7 +76,7 @@ class TiltRecorder:
         self.plate_ids, self.spill_box, self.record, self.step_index = plate_ids, spill_box, record, step_index
         self.n = max(1, int(round(record_interval_s / O.dt)))
         self.dt_chunk = self.n * O.dt
-        self.x0 = cell.pos[0]
+        self.x0 = cell.slide_point()[0]
         self.t0 = O.time
         self.gap0 = cell.bottom_z()
         self.min_gap = self.gap0
@@ -83,13 +85,13 @@ class TiltRecorder:
 
     def slide(self):
         """Slide displacement of the cell down the slope so far (m)."""
-        return self.cell.pos[0] - self.x0
+        return self.cell.slide_point()[0] - self.x0
 
     def chunk(self):
         """Advance one chunk; returns (slide displacement m, force of the particles on the plate N)."""
         self.scene.advance(self.n)
         f = force_sum(self.plate_ids) if self.plate_ids else Vector3(0, 0, 0)
-        x = self.cell.pos[0] - self.x0
+        x = self.cell.slide_point()[0] - self.x0
         gap = self.cell.bottom_z()
         self.min_gap = min(self.min_gap, gap)
         self.record.append((self.step_index, O.time - self.t0, self.tilt.angle_deg, x, gap, f[0], f[1], f[2]))
@@ -102,18 +104,25 @@ class TiltRecorder:
 
 def free_the_cell(scene, cell, lid, proc, step_index):
     """Join lid and cell, free the cell's translations (never damped); with
-    settle_before_tilt let it come to rest at zero tilt. Returns its drift (m) or None."""
-    join(cell, lid)
+    settle_before_tilt let it come to rest at zero tilt. Returns its drift (m) or None.
+    The audit options (pycal.rig_contract.TILT_OPTION_DEFAULTS): lid_during_tilt: free
+    leaves the lid free on the contents instead of joining it; sliding_cell_rotations:
+    free lets the cell turn too."""
+    if tilt_option(proc, "lid_during_tilt") == "joined":
+        join(cell, lid)
+    else:
+        lid.free()
     set_damped([cell.id], False)
-    cell.hold(False)
+    cell.hold(False, rotations_free=tilt_option(proc, "sliding_cell_rotations") == "free")
     if not proc["settle_before_tilt"]:
         return None
     # freed at zero tilt, the cell can drift while the unloaded contents relax (wet fines
     # after 60 kPa: 4.3 mm before 0.5 deg of tilt, measured); that is not sliding
-    x_free, y_free = cell.pos[0], cell.pos[1]
+    p_free = Vector3(cell.slide_point())
     with CLOCK.phase("settle_before_tilt"):
         drive(scene.settle(f"cell freed before the tilt of step {step_index}"))
-    return math.hypot(cell.pos[0] - x_free, cell.pos[1] - y_free)
+    p_now = cell.slide_point()
+    return math.hypot(p_now[0] - p_free[0], p_now[1] - p_free[1])
 
 
 def static_onset(run, proc):

@@ -1,0 +1,168 @@
+"""Why does the internal-friction cell read high? One suspect changed at a time (issue 28).
+
+    /usr/bin/python3 bench/internal_cell_audit.py RUNS_DIR [--material M3-dry] \
+        [--frictions 0.1,0.5] [--seeds 5] [--suspects all] [--workers 1] [--table-only] [--out table.md]
+
+Runs `pycal run internal_friction` (cached: a stopped audit resumes) at the dry fines'
+internal-friction stage's own settings (configs/calibrations/zinc_ore.yaml: its
+rig_overrides, and E 1e8 Pa, the calibrated stiffness), for every particle friction in
+--frictions and every suspect below, on seeds 1..--seeds, then prints per suspect and
+friction: mu_static per consolidation step and the stage's response (the mean offset from
+the lab curve over the steps >= 10 kPa, pycal.post.friction.friction_offset) with their
+seed SD, the change against the baseline (the rig as the study runs it) +- its standard
+error (the fills differ, so unpaired), and the median CPU per run.
+
+The suspects (each alone; docs/rigs.md "internal_friction"):
+  rotations_free  the mobile cell may turn (procedure.sliding_cell_rotations: free)
+  lid_free        the lid rests free on the contents instead of being joined to the cell
+  fine_rim        128 facets instead of 32 round both cells (rim vertices pinch particles)
+  onset_3mm       the onset read at 3 mm of slide instead of 1 mm
+  gap_6mm         6 mm between the cells instead of 2 mm (strike level moved with it)
+"""
+import argparse
+import json
+import math
+import statistics
+import subprocess
+import sys
+from pathlib import Path
+
+ROOT = Path(__file__).resolve().parent.parent
+sys.path.insert(0, str(ROOT))
+sys.path.insert(0, str(ROOT / "bench"))
+from friction_equivalence import mean_sd_se, step_values  # noqa: E402
+from pycal.calibration.study_config import load_study  # noqa: E402
+from pycal.files import write_text  # noqa: E402
+from pycal.post.friction import friction_offset  # noqa: E402
+
+STUDY = ROOT / "configs" / "calibrations" / "zinc_ore.yaml"
+STAGE = "internal_friction"
+YOUNGS_MODULUS_PA = 1e8            # the stiffness the study's stage runs at (the stiffness stage's bound)
+
+SUSPECTS = {
+    "baseline": {},
+    "rotations_free": {"rig.procedure.sliding_cell_rotations": "free"},
+    "lid_free": {"rig.procedure.lid_during_tilt": "free"},
+    "fine_rim": {"rig.geometry.cell_facet_segments_count": 128},
+    "onset_3mm": {"rig.procedure.slide_onset_displacement_m": 0.003},
+    "gap_6mm": {"rig.geometry.cell_gap_m": 0.006, "rig.procedure.strike_level_height_m": 0.196},
+}
+
+
+def stage_overrides(material):
+    """The rig_overrides of the material's internal-friction stage in the shipped study."""
+    study = load_study(STUDY)
+    for stage in study["materials"][material]:
+        if stage.get("name") == STAGE:
+            return dict(stage.get("rig_overrides") or {})
+    raise SystemExit(f"{STUDY}: no stage {STAGE!r} for {material}")
+
+
+def settings(material, friction, suspect):
+    """The --set overrides of one audit point."""
+    ov = stage_overrides(material)
+    ov["contact.youngs_modulus_pa"] = YOUNGS_MODULUS_PA
+    ov[f"interactions.{material}.friction_coefficient"] = friction
+    ov.update(SUSPECTS[suspect])
+    return ov
+
+
+def run_point(runs, material, friction, suspect, seeds, workers):
+    cmd = [sys.executable, "-m", "pycal", "run", "internal_friction", "--material", material,
+           "--seeds", str(seeds), "--workers", str(workers), "--out", str(runs)]
+    for k, v in settings(material, friction, suspect).items():
+        cmd += ["--set", f"{k}={json.dumps(v)}"]
+    print(f"[audit] {suspect} at friction {friction}: {seeds} seeds", flush=True)
+    subprocess.run(cmd, cwd=ROOT, check=True)
+
+
+def suspect_of(overrides, material):
+    """Which suspect a run's overrides are (None: not an audit run)."""
+    for name, ov in SUSPECTS.items():
+        fr = overrides.get(f"interactions.{material}.friction_coefficient")
+        if fr is not None and overrides == settings(material, fr, name):
+            return name, fr
+    return None
+
+
+def load(runs, material):
+    """{(suspect, friction): [result]} of the audit's runs in RUNS_DIR."""
+    out = {}
+    for path in sorted((Path(runs) / "internal_friction").glob("*/result.json")):
+        r = json.loads(path.read_text())
+        if r.get("material") != material:
+            continue
+        key = suspect_of(r["job"].get("overrides") or {}, material)
+        if key:
+            out.setdefault(key, []).append(r)
+    return out
+
+
+def fmt(x, nd=3):
+    return "-" if x is None or (isinstance(x, float) and math.isnan(x)) else f"{x:.{nd}f}"
+
+
+def offset(r):
+    """The stage response of one run (None when it cannot be read)."""
+    try:
+        return friction_offset(r)
+    except ValueError:
+        return None
+
+
+def table(groups):
+    """Markdown rows: per friction and suspect, mu_static per step, the offset, the change."""
+    stresses = sorted({s for rs in groups.values() for r in rs for s in r["stress_pa"]})
+    head = ("| particle friction | suspect | seeds | " + " | ".join(f"mu_static {s / 1e3:g} kPa" for s in stresses)
+            + " | offset from the lab (SD) | change vs baseline +- SE | CPU s per run (median) |")
+    lines = [head, "|" + "---|" * (6 + len(stresses))]
+    for fr in sorted({f for _, f in groups}):
+        base = groups.get(("baseline", fr), [])
+        mb, _, seb = mean_sd_se([offset(r) for r in base])
+        for name in SUSPECTS:
+            rs = groups.get((name, fr))
+            if not rs:
+                continue
+            cells = []
+            for s in stresses:
+                m, sd, _ = mean_sd_se([step_values(r)[0].get(s) for r in rs])
+                cells.append(f"{fmt(m)} ({fmt(sd)})")
+            m, sd, se = mean_sd_se([offset(r) for r in rs])
+            change = "-" if name == "baseline" or m is None or mb is None else \
+                f"{m - mb:+.3f} +- {math.hypot(se, seb):.3f}"
+            cpu = statistics.median(r["provenance"]["cpu_time_s"] for r in rs)
+            stuck = sum(len(step_values(r)[2]) for r in rs)
+            lines.append(f"| {fr} | {name}{f' ({stuck} stuck steps)' if stuck else ''} | {len(rs)} | "
+                         + " | ".join(cells) + f" | {fmt(m)} ({fmt(sd)}) | {change} | {cpu:.0f} |")
+    return "\n".join(lines)
+
+
+def main(argv=None):
+    ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
+    ap.add_argument("runs")
+    ap.add_argument("--material", default="M3-dry")
+    ap.add_argument("--frictions", default="0.1,0.5")
+    ap.add_argument("--seeds", type=int, default=5)
+    ap.add_argument("--suspects", default="all", help="comma list of " + ", ".join(SUSPECTS))
+    ap.add_argument("--workers", type=int, default=1)
+    ap.add_argument("--table-only", action="store_true", help="only tabulate the runs already in RUNS_DIR")
+    ap.add_argument("--out", default=None, help="also write the table (markdown) here")
+    args = ap.parse_args(argv)
+    names = list(SUSPECTS) if args.suspects == "all" else ["baseline"] + [
+        s for s in args.suspects.split(",") if s != "baseline"]
+    unknown = [s for s in names if s not in SUSPECTS]
+    if unknown:
+        raise SystemExit(f"--suspects: unknown {', '.join(unknown)} (known: {', '.join(SUSPECTS)})")
+    frictions = [float(f) for f in args.frictions.split(",")]
+    if not args.table_only:
+        for fr in frictions:
+            for name in names:
+                run_point(args.runs, args.material, fr, name, args.seeds, args.workers)
+    text = table(load(args.runs, args.material))
+    print(text)
+    if args.out:
+        write_text(Path(args.out), text + "\n")
+
+
+if __name__ == "__main__":
+    main()
