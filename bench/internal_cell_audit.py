@@ -18,6 +18,8 @@ The suspects (each alone; docs/rigs.md "internal_friction"):
   fine_rim        128 facets instead of 32 round both cells (rim vertices pinch particles)
   onset_3mm       the onset read at 3 mm of slide instead of 1 mm
   gap_6mm         6 mm between the cells instead of 2 mm (strike level moved with it)
+  force_drive     a horizontal force W tan(angle) on the mobile cell under vertical gravity
+                  instead of the tilted table (the case study's own DEM model)
 """
 import argparse
 import json
@@ -46,6 +48,7 @@ SUSPECTS = {
     "fine_rim": {"rig.geometry.cell_facet_segments_count": 128},
     "onset_3mm": {"rig.procedure.slide_onset_displacement_m": 0.003},
     "gap_6mm": {"rig.geometry.cell_gap_m": 0.006, "rig.procedure.strike_level_height_m": 0.196},
+    "force_drive": {"rig.procedure.shear_drive": "force_ramp"},
 }
 
 
@@ -53,7 +56,7 @@ def stage_overrides(material):
     """The rig_overrides of the material's internal-friction stage in the shipped study."""
     study = load_study(STUDY)
     for stage in study["materials"][material]:
-        if stage.get("name") == STAGE:
+        if stage.get("label") == STAGE:
             return dict(stage.get("rig_overrides") or {})
     raise SystemExit(f"{STUDY}: no stage {STAGE!r} for {material}")
 

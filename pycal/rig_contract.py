@@ -42,9 +42,11 @@ def seed_job(batch_job, seed):
 # ---------------------------------------------------------------- optional rig keys
 # Keys a rig config may leave out, with the value the rig uses then (the rig as it always ran:
 # leaving them out keeps the job ids). The tilt-table options of the internal-friction audit:
-# the sliding cell's rotations during the tilt, and the lid joined to the cell or free on the
-# contents (docs/rigs.md, "internal_friction").
-TILT_OPTION_DEFAULTS = {"sliding_cell_rotations": "blocked", "lid_during_tilt": "joined"}
+# the sliding cell's rotations during the tilt, the lid joined to the cell or free on the
+# contents, and the shear drive: the table tilted (gravity rotated) or, as the case study's own
+# DEM model, a horizontal force on the mobile cell that rises as W tan(angle) under vertical
+# gravity (docs/rigs.md, "internal_friction").
+TILT_OPTION_DEFAULTS = {"sliding_cell_rotations": "blocked", "lid_during_tilt": "joined", "shear_drive": "tilt"}
 
 
 def tilt_option(procedure, key):

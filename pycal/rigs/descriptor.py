@@ -112,16 +112,23 @@ def particle_fits_cell(job):
                               f"{job['material']} ({size:g} m)")
 
 
-def tilt_options_need_fresh_fill(job):
-    """A ConfigError when procedure.sliding_cell_rotations: free or lid_during_tilt: free is
-    asked of a sequential fill: a cell that tipped, or a lid that slid off with the contents,
-    is not put back for the next step (only fill_each_step: fresh starts each step anew)."""
+def check_tilt_options(job):
+    """A ConfigError when an audit option (procedure.sliding_cell_rotations: free,
+    lid_during_tilt: free, shear_drive: force_ramp) is asked of a sequential fill (a cell
+    that tipped, or a lid that slid off with the contents, is not put back for the next
+    step: only fill_each_step: fresh starts each step anew), or the force drive with
+    measure_dynamic_friction (the dynamic formula is the tilted table's)."""
     from ..errors import ConfigError
     from ..rig_contract import TILT_OPTION_DEFAULTS, tilt_option
     p = job["rig_config"]["procedure"]
+
+    def where(key):
+        return "--set" if f"rig.procedure.{key}" in (job.get("overrides") or {}) else f"configs/rigs/{job['rig']}.yaml"
+
     for key, default in TILT_OPTION_DEFAULTS.items():
         if tilt_option(p, key) != default and p["fill_each_step"] != "fresh":
-            overridden = f"rig.procedure.{key}" in (job.get("overrides") or {})
-            where = "--set" if overridden else f"configs/rigs/{job['rig']}.yaml"
-            raise ConfigError(where, f"procedure.{key}", f"{p[key]!r} needs procedure.fill_each_step: fresh "
+            raise ConfigError(where(key), f"procedure.{key}", f"{p[key]!r} needs procedure.fill_each_step: fresh "
                               "(the cell or lid is not put back between steps)")
+    if tilt_option(p, "shear_drive") == "force_ramp" and p["measure_dynamic_friction"]:
+        raise ConfigError(where("shear_drive"), "procedure.shear_drive", "'force_ramp' needs "
+                          "procedure.measure_dynamic_friction: false (mu_dynamic is read on the tilted table)")

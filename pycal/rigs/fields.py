@@ -105,6 +105,7 @@ FIELDS = {
     "particle_damping_during_tilt": Field("choice", choices=("damped", "undamped", "undamped_when_sliding")),
     "sliding_cell_rotations": Field("choice", choices=("blocked", "free")),
     "lid_during_tilt": Field("choice", choices=("joined", "free")),
+    "shear_drive": Field("choice", choices=("tilt", "force_ramp")),
     "vibration_frequency_hz": positive("a frequency"),
     "vibration_amplitude_horizontal_m": non_negative(),
     "vibration_amplitude_vertical_m": non_negative(),

@@ -197,6 +197,8 @@ def cli_cases():
           "--set", "rig.procedure.sliding_cell_rotations=free"], "needs procedure.fill_each_step: fresh"),
         (["run", "wall_friction", "--material", "M3-dry", "--set", "rig.procedure.lid_during_tilt=free"],
          "no such key to override"),
+        (["run", "internal_friction", "--material", "M3-dry", "--set", "rig.procedure.shear_drive=force_ramp"],
+         "needs procedure.measure_dynamic_friction: false"),
         (["job", "fill", "--material", "M2", "--seeds", "0"], "--seeds"),
         (["batch-table", "fill", "--material", "M2", "--table", "t.table", "--workers", "0"], "--workers"),
         (["calibrate", "--seed-base", "-1"], "--seed-base"),

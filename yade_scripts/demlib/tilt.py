@@ -231,6 +231,8 @@ def run_friction_rig(job, build, out_dir):
         "steps": steps_done + O.iter,
         "particle_damping_during_tilt": p["particle_damping_during_tilt"],
     })
+    if any("drive_weight_n" in s for s in steps):      # shear_drive: force_ramp
+        out["drive_weight_n"] = [s.get("drive_weight_n") for s in steps]
     if getattr(scene.contact, "n_updates", None) is not None:
         out["cohesion_update_count"] = cohesion_updates + scene.contact.n_updates
     # friction vs stress against the lab curve (CSV, PNG, misfit): pycal.post.friction; an

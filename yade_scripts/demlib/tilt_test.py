@@ -2,7 +2,9 @@
 
 The table is tilted by rotating the gravity vector about the scene's y axis: the
 bearing plate stays in the plane z = 0 and "down the slope" is +x, so the sliding
-displacement is simply the x displacement of the rigid cell.
+displacement is simply the x displacement of the rigid cell. (procedure.shear_drive:
+force_ramp instead pushes the cell with a horizontal force W tan(angle) under vertical
+gravity: ForceDrive.)
 
 tilt_test() runs the phases in order:
 1. free the cell: the lid is joined to it (one rigid body hanging on the contents) and
@@ -47,6 +49,36 @@ class Tilt:
         self.angle_deg = angle_deg
         t = math.radians(angle_deg)
         self.scene.newton.gravity = Vector3(self.g * math.sin(t), 0.0, -self.g * math.cos(t))
+
+
+class ForceDrive:
+    """The shear drive of procedure.shear_drive: force_ramp (the case study's own DEM model
+    of the internal-friction cell): gravity stays vertical and a horizontal force
+    F = W tan(angle) pushes the mobile cell down +x (W: the weight on the shear plane, N),
+    so the ratio F / W follows the tilted table's tan(angle) and an onset at `angle` reads
+    the same mu_static = tan(angle). It stands in for Tilt (the same set(angle_deg)); the
+    angle is capped at MAX_ANGLE_DEG (F = 11 W: a cell that has not slid by then sticks)."""
+    MAX_ANGLE_DEG = 85.0
+
+    def __init__(self, scene, body_id, weight_n):
+        self.scene, self.body_id, self.weight_n = scene, body_id, weight_n
+        self.angle_deg = 0.0
+
+    def set(self, angle_deg):
+        self.angle_deg = angle_deg
+        f = self.weight_n * math.tan(math.radians(min(angle_deg, self.MAX_ANGLE_DEG)))
+        O.forces.setPermF(self.body_id, Vector3(f, 0.0, 0.0))
+
+    def release(self):
+        O.forces.setPermF(self.body_id, Vector3(0.0, 0.0, 0.0))
+
+
+def weight_on_shear_plane(scene, cell, lid, shear_plane_z):
+    """(cell + lid + the particles whose centre is above shear_plane_z) x g (N): what the
+    shear plane of the internal-friction cell carries under vertical gravity."""
+    m = cell.mass + lid.mass
+    m += sum(b.state.mass for b in scene.live_spheres() if b.state.pos[2] > shear_plane_z)
+    return m * scene.g
 
 
 def remove_spilled(scene, box):
@@ -267,9 +299,18 @@ def tilt_test(scene, tilt, cell, lid, plate_ids, spill_box, proc, record, step_i
     drift = free_the_cell(scene, cell, lid, proc, step_index)
     if mode == "undamped":
         set_damped(scene.sphere_ids, False)
+    weight = None
+    if tilt_option(proc, "shear_drive") == "force_ramp":
+        # the shear plane: the middle of the gap under the mobile cell (internal_friction)
+        plane_z = cell.bottom_z() - 0.5 * scene.rig["geometry"]["cell_gap_m"]
+        weight = weight_on_shear_plane(scene, cell, lid, plane_z)
+        tilt = ForceDrive(scene, cell.id, weight)
     run = TiltRecorder(scene, tilt, cell, plate_ids, spill_box, record, step_index, proc["record_interval_s"])
     with CLOCK.phase("tilt_static"):
         out, angle = static_onset(run, proc)
+    if weight is not None:
+        tilt.release()
+        out["drive_weight_n"] = weight
     slid = out["onset_angle_deg"] is not None
     if slid and proc["measure_dynamic_friction"]:
         if mode == "undamped_when_sliding":
