@@ -331,8 +331,11 @@ def write_report(study_dir):
         for k, v in ov.items():
             rng = iv.get(k)
             shown = f"{_num(rng[1])} - {_num(rng[2])}" if rng else ""
-            parts.append(f"<tr><td>{_esc(k)}</td><td class=num>{_num(v) if isinstance(v, (int, float)) else _esc(v)}"
-                         f"</td><td class=num>{shown}</td><td>{_esc(src.get(k, ''))}</td></tr>")
+            if isinstance(v, dict):       # a law with its settings (a cohesion model): one line each, it wraps
+                cell = "<td>" + "<br>".join(f"{_esc(a)}: {_esc(b)}" for a, b in v.items()) + "</td>"
+            else:
+                cell = f"<td class=num>{_num(v) if isinstance(v, (int, float)) else _esc(v)}</td>"
+            parts.append(f"<tr><td>{_esc(k)}</td>{cell}<td class=num>{shown}</td><td>{_esc(src.get(k, ''))}</td></tr>")
         parts.append("</table>")
     parts.append("<h2>Provenance</h2><ul>" + _provenance_items(summary)
                  + f"<li>seeds {summary['seed_base']}, "
