@@ -22,6 +22,7 @@ The suspects (each alone; docs/rigs.md "internal_friction"):
                   instead of the tilted table (the case study's own DEM model)
 """
 import argparse
+import functools
 import json
 import math
 import statistics
@@ -32,7 +33,7 @@ from pathlib import Path
 ROOT = Path(__file__).resolve().parent.parent
 sys.path.insert(0, str(ROOT))
 sys.path.insert(0, str(ROOT / "bench"))
-from friction_equivalence import mean_sd_se, step_values  # noqa: E402
+from friction_equivalence import fmt, mean_sd_se, step_values  # noqa: E402
 from pycal.calibration.study_config import load_study  # noqa: E402
 from pycal.files import write_text  # noqa: E402
 from pycal.post.friction import friction_offset  # noqa: E402
@@ -52,8 +53,10 @@ SUSPECTS = {
 }
 
 
+@functools.lru_cache(maxsize=None)
 def stage_overrides(material):
-    """The rig_overrides of the material's internal-friction stage in the shipped study."""
+    """The rig_overrides of the material's internal-friction stage in the shipped study
+    (read once per material: settings() asks for it for every run it classifies)."""
     study = load_study(STUDY)
     for stage in study["materials"][material]:
         if stage.get("label") == STAGE:
@@ -63,7 +66,7 @@ def stage_overrides(material):
 
 def settings(material, friction, suspect):
     """The --set overrides of one audit point."""
-    ov = stage_overrides(material)
+    ov = dict(stage_overrides(material))          # a copy: the cached dict stays as read
     ov["contact.youngs_modulus_pa"] = YOUNGS_MODULUS_PA
     ov[f"interactions.{material}.friction_coefficient"] = friction
     ov.update(SUSPECTS[suspect])
@@ -99,10 +102,6 @@ def load(runs, material):
         if key:
             out.setdefault(key, []).append(r)
     return out
-
-
-def fmt(x, nd=3):
-    return "-" if x is None or (isinstance(x, float) and math.isnan(x)) else f"{x:.{nd}f}"
 
 
 def offset(r):

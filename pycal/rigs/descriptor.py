@@ -98,6 +98,12 @@ def tilt_phases(job, wait, settle_key):
     return out
 
 
+def config_source(job, section, key):
+    """Where a rig key of `job` came from, for an error line: '--set' when an override set
+    it, else the rig's config file."""
+    return "--set" if f"rig.{section}.{key}" in (job.get("overrides") or {}) else f"configs/rigs/{job['rig']}.yaml"
+
+
 def particle_fits_cell(job):
     """A ConfigError when the largest particle is not smaller than the cell's diameter
     or height (the rig could not hold one particle)."""
@@ -106,9 +112,7 @@ def particle_fits_cell(job):
     size = largest_size_m(job)
     for key in ("cell_inner_diameter_m", "cell_height_m"):
         if key in g and size >= g[key]:
-            overridden = f"rig.geometry.{key}" in (job.get("overrides") or {})
-            where = "--set" if overridden else f"configs/rigs/{job['rig']}.yaml"
-            raise ConfigError(where, f"geometry.{key}", f"{g[key]:g} m does not hold one particle of "
+            raise ConfigError(config_source(job, "geometry", key), f"geometry.{key}", f"{g[key]:g} m does not hold one particle of "
                               f"{job['material']} ({size:g} m)")
 
 
@@ -121,14 +125,10 @@ def check_tilt_options(job):
     from ..errors import ConfigError
     from ..rig_contract import TILT_OPTION_DEFAULTS, tilt_option
     p = job["rig_config"]["procedure"]
-
-    def where(key):
-        return "--set" if f"rig.procedure.{key}" in (job.get("overrides") or {}) else f"configs/rigs/{job['rig']}.yaml"
-
     for key, default in TILT_OPTION_DEFAULTS.items():
         if tilt_option(p, key) != default and p["fill_each_step"] != "fresh":
-            raise ConfigError(where(key), f"procedure.{key}", f"{p[key]!r} needs procedure.fill_each_step: fresh "
+            raise ConfigError(config_source(job, "procedure", key), f"procedure.{key}", f"{p[key]!r} needs procedure.fill_each_step: fresh "
                               "(the cell or lid is not put back between steps)")
     if tilt_option(p, "shear_drive") == "force_ramp" and p["measure_dynamic_friction"]:
-        raise ConfigError(where("shear_drive"), "procedure.shear_drive", "'force_ramp' needs "
+        raise ConfigError(config_source(job, "procedure", "shear_drive"), "procedure.shear_drive", "'force_ramp' needs "
                           "procedure.measure_dynamic_friction: false (mu_dynamic is read on the tilted table)")

@@ -1,8 +1,8 @@
 """internal_friction: two stacked cells on a tilt table (calibrates particle-particle
 friction). No replicas (gravity is rotated for the whole scene)."""
 from ._cells import CELL, FRICTION_RESPONSES, FRICTION_RESULT, POUR, TILT
-from .descriptor import RigDescriptor, particle_fits_cell, tilt_phases, check_tilt_options
-
+from ..rig_contract import TILT_OPTION_DEFAULTS
+from .descriptor import RigDescriptor, check_tilt_options, particle_fits_cell, tilt_phases
 
 
 def check_internal_friction_job(job):
@@ -16,7 +16,7 @@ DESCRIPTOR = RigDescriptor(
     geometry=CELL + ("cell_gap_m", "cell_mass_kg", "lid_mass_kg", "table_material", "table_half_width_m",
                      "lid_material"),
     procedure=POUR + TILT, phases=tilt_phases, result_keys=FRICTION_RESULT, responses=FRICTION_RESPONSES,
-    optional=("procedure.sliding_cell_rotations", "procedure.lid_during_tilt", "procedure.shear_drive"),
-    # the audit options (issue 28): absent = blocked / joined / tilt, the rig as it has always run (same job ids)
+    optional=tuple(f"procedure.{k}" for k in TILT_OPTION_DEFAULTS),   # the audit options (issue 28): left out,
+    # the rig runs as it always has (same job ids)
     check_job=check_internal_friction_job, post="friction",
     pictures=("friction_vs_stress.png",))

@@ -35,6 +35,7 @@ class RigidBody:
         self.inertia = inertia
         self.ref = self.members[0]
         self.ref_to_bottom = bottom_z - O.bodies[self.ref].state.pos[2]
+        self.rotations_free = False
 
     @property
     def body(self):
@@ -61,7 +62,7 @@ class RigidBody:
     def slide_point(self):
         """Where the slide is read (m): the reference member while the body only translates
         (as the rig has always read it), the centre of mass once it may also turn."""
-        if getattr(self, "rotations_free", False):
+        if self.rotations_free:
             return O.bodies[self.id].state.pos
         return self.pos
 

@@ -9,8 +9,9 @@ gravity: ForceDrive.)
 tilt_test() runs the phases in order:
 1. free the cell: the lid is joined to it (one rigid body hanging on the contents) and
    it translates freely (rotations blocked; procedure.lid_during_tilt and
-   sliding_cell_rotations: free change either, for the internal-friction audit); with procedure.settle_before_tilt it first
-   comes to rest at zero tilt (its drift is recorded, the slide is measured from there);
+   sliding_cell_rotations: free change either, for the internal-friction audit); with
+   procedure.settle_before_tilt it first comes to rest at zero tilt (its drift is
+   recorded, the slide is measured from there);
 2. static friction: tilt (at pre_tilt_rate_deg_s until the cell has slid
    pre_tilt_slide_fraction of the onset distance, then at the lab's tilt_rate_deg_s)
    until the cell has slid slide_onset_displacement_m (mu_static = tan of that angle);
