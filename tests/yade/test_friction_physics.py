@@ -252,6 +252,16 @@ def test_internal_friction_fresh_fill_per_step_repeats_bit_for_bit(tmp_path_fact
     assert_documented(r)
     assert r["mu_static"][0] == r["mu_static"][1]
     assert r["onset_angle_deg"][0] == r["onset_angle_deg"][1]
+    assert r["cell_rotation_onset_deg"] == [0.0, 0.0]       # a guided cell does not turn
+
+
+def test_a_cell_free_to_turn_records_how_far_it_turned(tmp_path_factory):
+    """sliding_cell_rotations: free (the internal-cell audit): the mobile cell tips as it
+    is pushed over the contents, and the rig says by how much at the onset (the guided
+    cell above reads exactly 0)."""
+    r = internal(tmp_path_factory, "internal_turning", {"rig.procedure.sliding_cell_rotations": "free"}, [3000])
+    assert r["onset_angle_deg"][0] is not None
+    assert 0.01 < r["cell_rotation_onset_deg"][0] < 45.0
 
 
 def test_internal_friction_of_frictionless_spheres_is_low_and_rises_with_contact_friction(tmp_path_factory):

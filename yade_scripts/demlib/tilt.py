@@ -116,7 +116,7 @@ STEP_KEYS = ("mu_static", "mu_dynamic", "sticks", "max_tilt_deg", "onset_angle_d
              "cell_gap_start_m", "cell_gap_min_m", "tilt_time_s", "lid_z_loaded_m", "lid_z_unloaded_m",
              "plate_force_loaded_n", "lid_force_loaded_n", "stress_reached_pa", "load_time_s",
              "spilled_particles_count", "drift_before_tilt_m", "pre_tilt_end_deg",
-             "wall_time_step_s")
+             "cell_rotation_onset_deg", "wall_time_step_s")
 RECORD_KEYS = ("stress_pa",) + STEP_KEYS          # columns of friction.csv, per-step arrays of result.json
 SPRING_COLUMNS = ["step_index_count", "time_s", "lid_stress_pa", "lid_position_m", "lid_force_n", "plate_force_n"]
 TILT_COLUMNS = ["step_index_count", "time_s", "tilt_deg", "slide_displacement_m", "cell_gap_m",

@@ -26,7 +26,7 @@ tilt_test() runs the phases in order:
 import math
 
 from yade import O
-from yade import Vector3
+from yade import Quaternion, Vector3
 
 from .jobio import RigFailure
 from .phase_clock import CLOCK
@@ -110,6 +110,7 @@ class TiltRecorder:
         self.n = max(1, int(round(record_interval_s / O.dt)))
         self.dt_chunk = self.n * O.dt
         self.x0 = cell.slide_point()[0]
+        self.ori0 = Quaternion(O.bodies[cell.id].state.ori)
         self.t0 = O.time
         self.gap0 = cell.bottom_z()
         self.min_gap = self.gap0
@@ -119,6 +120,13 @@ class TiltRecorder:
     def slide(self):
         """Slide displacement of the cell down the slope so far (m)."""
         return self.cell.slide_point()[0] - self.x0
+
+    def rotation_deg(self):
+        """How far the cell has turned since the recorder started (deg, any axis): 0 while its
+        rotations are blocked (sliding_cell_rotations: blocked)."""
+        turn = O.bodies[self.cell.id].state.ori * self.ori0.conjugate()
+        angle = abs(math.degrees(turn.toAxisAngle()[1])) % 360.0
+        return min(angle, 360.0 - angle)
 
     def chunk(self):
         """Advance one chunk; returns (slide displacement m, force of the particles on the plate N)."""
@@ -167,7 +175,8 @@ def static_onset(run, proc):
     dynamic_max_time_s to see whether it starts. Returns ({'onset_angle_deg',
     'plate_force_ratio_onset', 'pre_tilt_end_deg'}, the angle reached (deg));
     onset_angle_deg None when the cell did not slide; pre_tilt_end_deg the angle where the
-    lab rate took over (None without a pre-tilt)."""
+    lab rate took over (None without a pre-tilt); cell_rotation_onset_deg how far the cell
+    had turned by then (at the onset, or at the end of the hold when it did not slide)."""
     rate, max_tilt = proc["tilt_rate_deg_s"], proc["max_tilt_deg"]
     onset_d, hold_max = proc["slide_onset_displacement_m"], proc["dynamic_max_time_s"]
     pre_rate, pre_until = proc["pre_tilt_rate_deg_s"], proc["pre_tilt_slide_fraction"] * onset_d
@@ -196,7 +205,8 @@ def static_onset(run, proc):
                 onset_angle, onset_ratio = angle, plate_ratio(f)
             break
         x_prev, a_prev = x, angle
-    return {"onset_angle_deg": onset_angle, "plate_force_ratio_onset": onset_ratio, "pre_tilt_end_deg": pre_end}, angle
+    return {"onset_angle_deg": onset_angle, "plate_force_ratio_onset": onset_ratio, "pre_tilt_end_deg": pre_end,
+            "cell_rotation_onset_deg": run.rotation_deg()}, angle
 
 
 def _hold(run, travel_d, stall_s, hold_max, ratios):
