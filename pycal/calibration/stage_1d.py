@@ -11,7 +11,9 @@ A point the rig refuses becomes a limit: the bounds in use end halfway between i
 the nearest point that ran. When the target then lies beyond that limit (the stop rule
 says so, or the estimate sits on the limit), the stage probes halfway between the limit
 and the refused point (a probe that runs moves the limit out to it, one refused moves it
-in), until the gap is below PROBE_GAP_U of the bounds.
+in), until the gap is below PROBE_GAP_U of the bounds; so does an interval that ends on
+such a limit. A stage whose next point has already had REPEAT_RUNS_POINTS points' worth of
+runs stops there (stopping.REPEATS): more runs at one value narrow its mean, not the interval.
 The calibrated value is the estimate (4 significant digits).
 """
 import math
@@ -27,6 +29,7 @@ from . import plots
 from .names import unit_label
 
 PROBE_GAP_U = 0.02     # bisection towards a refused point stops at this gap (fraction of the bounds)
+REPEAT_RUNS_POINTS = 3  # a stage stops rather than run a point that has had this many points' worth of runs
 
 
 def _slope_per_u(st, scale, x0, y0):
@@ -99,6 +102,11 @@ def run(study, material, st):
         if side is None and not step.stop:
             u = float(scale.to_unit(step.estimate))
             side = -1 if u <= lo_u + 1e-9 else 1 if u >= hi_u - 1e-9 else None
+        if side is None and not step.stop:
+            # the interval (not the estimate) ends on the limit: what lies past it is unmeasured
+            # (M3-dry rolling, 2026-12-03: 0.1296 [0.1025, 0.2534], the limit 0.1025 run 8 times)
+            low_u, high_u = float(scale.to_unit(step.low)), float(scale.to_unit(step.high))
+            side = -1 if low_u <= lo_u + 1e-9 else 1 if high_u >= hi_u - 1e-9 else None
         if side is None:
             return None
         limit = lo_u if side < 0 else hi_u
@@ -156,6 +164,9 @@ def run(study, material, st):
         if probe is not None:
             study.log(f"  the target lies past the limit a refused point set: probing {p['label']} = {probe:.4g}")
             step.next_x = probe
+        elif xs.count(round_significant(step.next_x)) >= REPEAT_RUNS_POINTS * n:
+            step.stop = stopping.REPEATS       # nothing left to learn there
+            break
         try:
             point(step.next_x)
         except BudgetSpent:
@@ -199,6 +210,9 @@ def _message(step, p, scale, xs, ys, target, refused, lo_u, hi_u):
         near = [y for x, y in zip(xs, ys) if abs(float(scale.to_unit(x)) - float(scale.to_unit(at))) < 0.01]
         msg = (f"the target {target.value:.4g} lies beyond what {p['label']} = {at:.4g} reaches "
                f"({np.mean(near):.4g} there, {len(near)} runs)")
+    if step.stop == stopping.REPEATS:
+        x = round_significant(step.next_x)
+        msg += f"; stopped: the next point, {x:.4g}, had run {xs.count(x)} times already"
     if refused:
         msg += "; the rig refused " + ", ".join(f"{x:.4g}" for x, _ in refused) + f" ({refused[0][1][:160]})"
     return msg

@@ -14,13 +14,16 @@ A stage stops when (checked in this order)
      that bound and a point has been run at it: what the bounds allow cannot reach
      the target;
   3. "run budget spent": the next point would need more runs than the budget left.
-Only the first counts as met.
+Only the first counts as met. The 1-D driver adds "next point already run at length".
 """
+import math
+
 WITHIN = "interval within tolerance"
 BUDGET = "run budget spent"
 STUDY_BUDGET = "study run budget spent"      # the whole study's max_runs_count (said by the driver)
 BEYOND_UPPER = "target beyond the upper bound"
 BEYOND_LOWER = "target beyond the lower bound"
+REPEATS = "next point already run at length"   # said by the driver (pycal.calibration.stage_1d)
 BOUND_SHARE = 0.025
 MIN_POINTS = 3
 
@@ -32,12 +35,20 @@ def within_tolerance(estimate, low, high, tolerance):
 
 def unmeasured_side(estimate, low, high, points):
     """-1 when no point (parameter values that ran) lies in [low, estimate], +1 when none
-    lies in [estimate, high], 0 when both sides of the interval have one."""
-    if not any(low <= x <= estimate for x in points):
-        return -1
-    if not any(estimate <= x <= high for x in points):
-        return 1
-    return 0
+    lies in [estimate, high], 0 when both sides of the interval have one. When neither
+    side has one, the side the model bridges farther: the one whose nearest point lies
+    farther from the estimate (the wet cohesion stage of 2026-12-03 ran its 3rd and 4th
+    points just below an interval whose upper side was bridged to a point 0.06 away, and
+    the interval moved up past each of them: 6 runs of 316 CPU s chasing it)."""
+    lower = any(low <= x <= estimate for x in points)
+    upper = any(estimate <= x <= high for x in points)
+    if lower and upper:
+        return 0
+    if lower or upper:
+        return 1 if lower else -1
+    gap_below = min((estimate - x for x in points if x <= estimate), default=math.inf)
+    gap_above = min((x - estimate for x in points if x >= estimate), default=math.inf)
+    return 1 if gap_above > gap_below else -1
 
 
 def stop_reason(estimate, low, high, tolerance, p_below=0.0, p_above=0.0, ran_at_lower=False,

@@ -239,3 +239,26 @@ def test_the_new_rule_ends_near_the_root_behind_a_gap():
                 xs.append(x)
                 ys.append(BEND(x) + 3 * rng.standard_normal())
         assert abs(st.estimate - BEND_ROOT) < 0.05
+
+
+def test_when_neither_side_of_the_interval_has_a_point_the_wider_bridge_goes_first():
+    """unmeasured_side: a point just below the interval and the nearest one above far off:
+    the upper side is bridged farther, so it is measured first."""
+    assert stopping.unmeasured_side(0.037, 0.023, 0.052, [0.0, 0.0222, 0.1]) == 1
+    assert stopping.unmeasured_side(0.037, 0.023, 0.052, [0.0, 0.03, 0.1]) == 1     # lower side measured
+    assert stopping.unmeasured_side(0.037, 0.023, 0.052, [0.0, 0.045, 0.1]) == -1   # upper side measured
+    assert stopping.unmeasured_side(0.037, 0.023, 0.052, [0.035, 0.045]) == 0
+    assert stopping.unmeasured_side(0.05, 0.04, 0.06, [0.0, 0.062]) == -1           # 0.05 below, 0.012 above
+
+
+def test_the_wet_cohesion_stage_measures_the_bridged_side_first():
+    """The main job's wet cohesion stage of 2026-12-03 after its first three points (pressure
+    fraction 0.1, 0, 0.02216; its own nine responses): interval within tolerance, no point
+    inside it on either side, 0.02216 just below it and 0.1 far above. The old rule ran the
+    lower side (0.0300, then 0.0370: each landed below the interval as it moved up, 6 runs);
+    the next point now lies above the estimate, where the model bridges to 0.1."""
+    xs = [0.1] * 3 + [0.0] * 3 + [0.02216] * 3
+    ys = [24.9048, 25.9185, 27.4951, -15.1921, -15.5566, -2.184, -3.40811, -11.399, -14.9559]
+    st = step_1d(Scale(0.0, 0.5), xs, ys, 0.0, True, tolerance=0.02, band=5.0, runs_left=9, runs_per_point=3)
+    assert st.stop is None and st.low > 0.02216
+    assert st.estimate < st.next_x <= st.high

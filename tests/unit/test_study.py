@@ -666,6 +666,25 @@ def test_an_estimate_clipped_at_a_refused_limit_probes_past_it(tmp_path):
     assert p["low"] < 0.18 and holds(p, root)
 
 
+def test_a_stage_does_not_spend_its_budget_on_the_limit_it_cannot_pass(tmp_path):
+    """The main job of 2026-12-03 (M3-dry rolling): 0.02 refused, the probe 0.1025 ran, the
+    estimate 0.13 sat above the limit with the interval ending on it, and the stage ran
+    0.1025 seven more times (24 of its 36 runs at one value). Fake AoR = 30 + 60 x rolling,
+    noise 8 deg, refused below 0.095: the stage probes past the limit while the interval
+    ends on it, and never runs one value more than three points' worth (9 runs)."""
+    cfg = rolling_study(tmp_path, tolerance=0.05, max_runs=36)
+
+    def eta(j):
+        return j["materials"]["M3-dry"]["interactions"]["M3-dry"]["rolling_resistance_coefficient"]
+
+    ex = FakeRigs(results={"aor": lambda j: {"aor_mean_deg": 30.0 + 60.0 * eta(j)}}, noise={"aor_mean_deg": 8.0},
+                  refuse=lambda j: "no angle" if eta(j) < 0.095 else None)
+    (row,) = Study(cfg, ex, tmp_path / "out", log=quiet).run()
+    xs = [eta(j) for j in ex.asked]
+    assert max(xs.count(x) for x in set(xs)) <= 9, sorted(xs)
+    assert any(x < 0.1025 for x in xs if x != 0.02)        # probed past the limit 0.1025 (refused or not)
+
+
 def test_report_shows_pictures_held_values_both_verdicts_and_provenance(tmp_path, study_file):
     """Every calibrated stage of the report: a gallery of its rig's pictures (the AoR stages:
     the pile at the estimate and at the lowest and highest value run), the values it held
