@@ -14,6 +14,8 @@ error (the fills differ, so unpaired), and the median CPU per run.
 
 The suspects (each alone; docs/rigs.md "internal_friction"):
   rotations_free  the mobile cell may turn (procedure.sliding_cell_rotations: free)
+  turning_read_at_rim  the same, its slide read at the centre of its bottom rim, not its
+                  centre of mass (procedure.slide_read_at: shear_plane): tipping is not sliding
   lid_free        the lid rests free on the contents instead of being joined to the cell
   fine_rim        128 facets instead of 32 round both cells (rim vertices pinch particles)
   onset_3mm       the onset read at 3 mm of slide instead of 1 mm
@@ -45,6 +47,7 @@ YOUNGS_MODULUS_PA = 1e8            # the stiffness the study's stage runs at (th
 SUSPECTS = {
     "baseline": {},
     "rotations_free": {"rig.procedure.sliding_cell_rotations": "free"},
+    "turning_read_at_rim": {"rig.procedure.sliding_cell_rotations": "free", "rig.procedure.slide_read_at": "shear_plane"},
     "lid_free": {"rig.procedure.lid_during_tilt": "free"},
     "fine_rim": {"rig.geometry.cell_facet_segments_count": 128},
     "onset_3mm": {"rig.procedure.slide_onset_displacement_m": 0.003},
@@ -116,8 +119,9 @@ def table(groups):
     """Markdown rows: per friction and suspect, mu_static per step, the offset, the change."""
     stresses = sorted({s for rs in groups.values() for r in rs for s in r["stress_pa"]})
     head = ("| particle friction | suspect | seeds | " + " | ".join(f"mu_static {s / 1e3:g} kPa" for s in stresses)
-            + " | offset from the lab (SD) | change vs baseline +- SE | CPU s per run (median) |")
-    lines = [head, "|" + "---|" * (6 + len(stresses))]
+            + " | offset from the lab (SD) | change vs baseline +- SE | cell turned at the onset, deg (mean) "
+            "| CPU s per run (median) |")
+    lines = [head, "|" + "---|" * (7 + len(stresses))]
     for fr in sorted({f for _, f in groups}):
         base = groups.get(("baseline", fr), [])
         mb, _, seb = mean_sd_se([offset(r) for r in base])
@@ -132,10 +136,12 @@ def table(groups):
             m, sd, se = mean_sd_se([offset(r) for r in rs])
             change = "-" if name == "baseline" or m is None or mb is None else \
                 f"{m - mb:+.3f} +- {math.hypot(se, seb):.3f}"
+            turned = [a for r in rs for a in (r.get("cell_rotation_onset_deg") or []) if a is not None]
+            turned = f"{statistics.mean(turned):.2f}" if turned else "-"      # runs before 91c6321 did not record it
             cpu = statistics.median(r["provenance"]["cpu_time_s"] for r in rs)
             stuck = sum(len(step_values(r)[2]) for r in rs)
             lines.append(f"| {fr} | {name}{f' ({stuck} stuck steps)' if stuck else ''} | {len(rs)} | "
-                         + " | ".join(cells) + f" | {fmt(m)} ({fmt(sd)}) | {change} | {cpu:.0f} |")
+                         + " | ".join(cells) + f" | {fmt(m)} ({fmt(sd)}) | {change} | {turned} | {cpu:.0f} |")
     return "\n".join(lines)
 
 

@@ -45,8 +45,11 @@ def seed_job(batch_job, seed):
 # the sliding cell's rotations during the tilt, the lid joined to the cell or free on the
 # contents, and the shear drive: the table tilted (gravity rotated) or, as the case study's own
 # DEM model, a horizontal force on the mobile cell that rises as W tan(angle) under vertical
-# gravity (docs/rigs.md, "internal_friction").
-TILT_OPTION_DEFAULTS = {"sliding_cell_rotations": "blocked", "lid_during_tilt": "joined", "shear_drive": "tilt"}
+# gravity (docs/rigs.md, "internal_friction"); and where a cell free to turn has its slide read:
+# "body" (its centre of mass; a guided cell: its reference member) or "shear_plane" (the centre
+# of its bottom rim).
+TILT_OPTION_DEFAULTS = {"sliding_cell_rotations": "blocked", "lid_during_tilt": "joined", "shear_drive": "tilt",
+                        "slide_read_at": "body"}
 
 
 def tilt_option(procedure, key):

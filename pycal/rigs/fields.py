@@ -106,6 +106,7 @@ FIELDS = {
     "sliding_cell_rotations": Field("choice", choices=("blocked", "free")),
     "lid_during_tilt": Field("choice", choices=("joined", "free")),
     "shear_drive": Field("choice", choices=("tilt", "force_ramp")),
+    "slide_read_at": Field("choice", choices=("body", "shear_plane")),
     "vibration_frequency_hz": positive("a frequency"),
     "vibration_amplitude_horizontal_m": non_negative(),
     "vibration_amplitude_vertical_m": non_negative(),

@@ -32,10 +32,15 @@ def test_each_setting_is_found_again_from_its_overrides():
 def test_the_change_is_the_difference_of_the_mean_offsets_with_its_standard_error():
     base = [fake_run("baseline", 0.5, 0.70 + d, 0.60 + d, s) for s, d in enumerate((0.00, 0.02, -0.02), 1)]
     lid = [fake_run("lid_free", 0.5, 0.50 + d, 0.40 + d, s) for s, d in enumerate((0.00, 0.04, -0.04), 1)]
+    for r, turned in zip(lid, ((0.4, 0.6), (0.5, 0.5), (0.3, 0.7))):
+        r["cell_rotation_onset_deg"] = list(turned)
     text = audit.table({("baseline", 0.5): base, ("lid_free", 0.5): lid})
     row = next(line for line in text.splitlines() if "| lid_free |" in line)
     cells = [c.strip() for c in row.split("|")]
-    change, se = cells[-3].split(" +- ")
+    change, se = cells[-4].split(" +- ")
+    assert cells[-3] == "0.50"                            # mean turn of the cell at the onset over steps and seeds
+    base_row = next(line for line in text.splitlines() if "| baseline |" in line)
+    assert base_row.split("|")[-3].strip() == "-"        # runs without the record
     # every step 0.2 lower, so the offset from any lab curve is 0.2 lower
     assert float(change) == pytest.approx(-0.200, abs=1e-3)
     want = math.hypot(statistics.stdev((0.0, 0.02, -0.02)), statistics.stdev((0.0, 0.04, -0.04))) / math.sqrt(3)

@@ -264,6 +264,18 @@ def test_a_cell_free_to_turn_records_how_far_it_turned(tmp_path_factory):
     assert 0.01 < r["cell_rotation_onset_deg"][0] < 45.0
 
 
+def test_a_tipping_cell_moves_its_centre_of_mass_before_its_rim(tmp_path_factory):
+    """slide_read_at: shear_plane reads a turning cell's slide at the centre of its bottom
+    rim: a cell that tips forward carries its centre of mass (~70 mm up) ahead of the rim on
+    the shear plane, so the same fill (same seed) reaches 1 mm of slide later there, after
+    turning further (M3-dry, 5 seeds at friction 0.5: 1.7 - 2.9 deg against 0.5)."""
+    com = internal(tmp_path_factory, "internal_turning", {"rig.procedure.sliding_cell_rotations": "free"}, [3000])
+    rim = internal(tmp_path_factory, "internal_turning_rim", {"rig.procedure.sliding_cell_rotations": "free",
+                                                             "rig.procedure.slide_read_at": "shear_plane"}, [3000])
+    assert rim["onset_angle_deg"][0] > com["onset_angle_deg"][0]
+    assert rim["cell_rotation_onset_deg"][0] > com["cell_rotation_onset_deg"][0]
+
+
 def test_internal_friction_of_frictionless_spheres_is_low_and_rises_with_contact_friction(tmp_path_factory):
     """Frictionless, non-rolling spheres shear at a low angle (only the packing's
     geometry resists: sphere packings without contact friction shear at tan ~0.1);

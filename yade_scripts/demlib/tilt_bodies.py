@@ -36,6 +36,7 @@ class RigidBody:
         self.ref = self.members[0]
         self.ref_to_bottom = bottom_z - O.bodies[self.ref].state.pos[2]
         self.rotations_free = False
+        self.rim_offset = None        # body frame: centre of mass -> centre of the bottom rim (see hold)
 
     @property
     def body(self):
@@ -49,21 +50,31 @@ class RigidBody:
     def bottom_z(self):
         return O.bodies[self.ref].state.pos[2] + self.ref_to_bottom
 
-    def hold(self, hold=True, rotations_free=False):
+    def hold(self, hold=True, rotations_free=False, read_at_shear_plane=False):
         """Fix it in place (all six DOFs) or release its translations (rotations stay
         blocked: the cell and lid are guided, they do not tip; rotations_free releases
-        them too, and the slide is then read at the body's centre of mass)."""
+        them too, and the slide is then read at the body's centre of mass, or with
+        read_at_shear_plane at the centre of its bottom rim, which moves with the body:
+        a tipping cell moves its centre of mass, not the rim on the shear plane)."""
         st = O.bodies[self.id].state
         st.vel = Vector3(0, 0, 0)
         st.angVel = Vector3(0, 0, 0)
         st.blockedDOFs = "xyzXYZ" if hold else ("" if rotations_free else "XYZ")
         self.rotations_free = rotations_free and not hold
+        self.rim_offset = None
+        if self.rotations_free and read_at_shear_plane:
+            rim = Vector3(st.pos[0], st.pos[1], self.bottom_z())      # the axis is vertical at release
+            self.rim_offset = st.ori.conjugate() * (rim - st.pos)       # in the body's own frame
 
     def slide_point(self):
         """Where the slide is read (m): the reference member while the body only translates
-        (as the rig has always read it), the centre of mass once it may also turn."""
+        (as the rig has always read it), the centre of mass once it may also turn, or the
+        centre of its bottom rim (hold(read_at_shear_plane=True))."""
+        st = O.bodies[self.id].state
+        if self.rotations_free and self.rim_offset is not None:
+            return st.pos + st.ori * self.rim_offset
         if self.rotations_free:
-            return O.bodies[self.id].state.pos
+            return st.pos
         return self.pos
 
     def lift_bottom_to(self, z):

@@ -148,13 +148,15 @@ def free_the_cell(scene, cell, lid, proc, step_index):
     settle_before_tilt let it come to rest at zero tilt. Returns its drift (m) or None.
     The audit options (pycal.rig_contract.TILT_OPTION_DEFAULTS): lid_during_tilt: free
     leaves the lid free on the contents instead of joining it; sliding_cell_rotations:
-    free lets the cell turn too."""
+    free lets the cell turn too (slide_read_at: shear_plane reads its slide at the centre
+    of its bottom rim instead of its centre of mass)."""
     if tilt_option(proc, "lid_during_tilt") == "joined":
         join(cell, lid)
     else:
         lid.free()
     set_damped([cell.id], False)
-    cell.hold(False, rotations_free=tilt_option(proc, "sliding_cell_rotations") == "free")
+    cell.hold(False, rotations_free=tilt_option(proc, "sliding_cell_rotations") == "free",
+              read_at_shear_plane=tilt_option(proc, "slide_read_at") == "shear_plane")
     if not proc["settle_before_tilt"]:
         return None
     # freed at zero tilt, the cell can drift while the unloaded contents relax (wet fines
