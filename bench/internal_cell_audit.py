@@ -136,8 +136,8 @@ def table(groups):
             m, sd, se = mean_sd_se([offset(r) for r in rs])
             change = "-" if name == "baseline" or m is None or mb is None else \
                 f"{m - mb:+.3f} +- {math.hypot(se, seb):.3f}"
-            turned = [a for r in rs for a in (r.get("cell_rotation_onset_deg") or []) if a is not None]
-            turned = f"{statistics.mean(turned):.2f}" if turned else "-"      # runs before 91c6321 did not record it
+            turns = [a for r in rs for a in (r.get("cell_rotation_onset_deg") or []) if a is not None]
+            turned = f"{statistics.mean(turns):.2f}" if turns else "-"      # runs before 91c6321 did not record it
             cpu = statistics.median(r["provenance"]["cpu_time_s"] for r in rs)
             stuck = sum(len(step_values(r)[2]) for r in rs)
             lines.append(f"| {fr} | {name}{f' ({stuck} stuck steps)' if stuck else ''} | {len(rs)} | "

@@ -11,18 +11,17 @@ error (bias). --extra-bends adds two large short bends (variance 3.0 at length 0
 Pure maths, no YADE.
 """
 import argparse
-import math
 import sys
 from pathlib import Path
 
 import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parent.parent))
+sys.path.insert(0, str(Path(__file__).resolve().parent))
 import pycal.stats.gp as gp  # noqa: E402
 from pycal.stats.scales import Scale  # noqa: E402
 from pycal.stats.sequential import step_1d  # noqa: E402
-
-ROOT = 0.1 * math.sqrt(10 / 36)
+from unmeasured_side_toy import ROOT, response  # noqa: E402  (one toy curve for both benches)
 
 
 def main(argv=None):
@@ -38,7 +37,7 @@ def main(argv=None):
     for d in range(a.draws):
         rng = np.random.default_rng(d)
         xs = [x for x in design for _ in range(3)]
-        ys = [-10 + 36 * (x / 0.1) ** 2 + 7 * rng.standard_normal() for x in xs]
+        ys = [response(x) + 7 * rng.standard_normal() for x in xs]
         st = step_1d(Scale(0.0, 0.5), xs, ys, 0.0, True, tolerance=0.02, runs_left=0)
         hits += st.low <= ROOT <= st.high
         half.append(0.5 * (st.high - st.low))

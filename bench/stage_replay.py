@@ -4,7 +4,7 @@
 
 STUDY_DIR is a study's output folder (runs/study/zinc_ore). Each 1-D stage's runs are fed,
 point by point in the order they ran, to the same decision the study made
-(pycal.stats.sequential.step_1d, the stage's target, tolerance and budget from the config):
+(pycal.calibration.stage_1d.decide_step, the stage's target, tolerance and budget from the config):
 estimate, 95 % interval, interval half-width / tolerance, the stop reason and the next point
 it asks for. No YADE run. The limits a refused point sets are not replayed (a stage with a
 refused point shows the bounds' view). Used to find runs a stage spent without learning
@@ -14,14 +14,15 @@ import argparse
 import csv
 import json
 import sys
+import tempfile
 from pathlib import Path
 
 import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parent.parent))
+from pycal.calibration.stage_1d import decide_step  # noqa: E402
 from pycal.calibration.study import Study  # noqa: E402
 from pycal.stats.scales import Scale  # noqa: E402
-from pycal.stats.sequential import step_1d  # noqa: E402
 
 
 class _NoRuns:
@@ -61,12 +62,7 @@ def replay(study, rows, out=print):
                 ys += vals
                 line = f"  {x:.4g}: {np.mean(vals):.4g} (n {len(xs)})"
                 if len(set(xs)) >= 2:
-                    s = step_1d(scale, xs, ys, tgt.value, p["increasing"],
-                                tolerance=None if p["tolerance_is_percent"] else p["tolerance"],
-                                tolerance_percent=p["tolerance"] if p["tolerance_is_percent"] else None,
-                                standard_error=tgt.standard_error, band=tgt.band,
-                                runs_left=st["max_runs_count"] - len(xs), runs_per_point=n,
-                                standard_error_dof=tgt.standard_error_dof)
+                    s = decide_step(p, scale, xs, ys, tgt, st["max_runs_count"] - len(xs), n)
                     hw = max(s.estimate - s.low, s.high - s.estimate)
                     nxt = "-" if s.next_x is None else f"{s.next_x:.4g}"
                     line += (f" -> {s.estimate:.4g} [{s.low:.4g}, {s.high:.4g}], half-width / tolerance "
@@ -86,7 +82,6 @@ def main(argv=None):
         return 2
     with open(runs_csv, newline="") as fh:
         rows = list(csv.DictReader(fh))
-    import tempfile
     with tempfile.TemporaryDirectory() as tmp:
         replay(Study(a.config, _NoRuns(), tmp, log=lambda *_: None), rows)
     return 0

@@ -45,6 +45,16 @@ def _slope_per_u(st, scale, x0, y0):
     return slope if p["increasing"] else -slope
 
 
+def decide_step(p, scale, xs, ys, target, runs_left, runs_per_point, lo_u=0.0, hi_u=1.0):
+    """The stage's decision after its runs (xs, ys): step_1d with the stage parameter p's
+    tolerance and the Target's value, band and standard error (also bench/stage_replay.py)."""
+    return step_1d(scale, xs, ys, target.value, p["increasing"],
+                   tolerance=None if p["tolerance_is_percent"] else p["tolerance"],
+                   tolerance_percent=p["tolerance"] if p["tolerance_is_percent"] else None,
+                   standard_error=target.standard_error, band=target.band, runs_left=runs_left,
+                   runs_per_point=runs_per_point, lo_u=lo_u, hi_u=hi_u, standard_error_dof=target.standard_error_dof)
+
+
 def run(study, material, st):
     """Run the stage; returns its row (parameters, responses, met, stop reason, plots)."""
     p = st["parameter"]
@@ -102,11 +112,11 @@ def run(study, material, st):
         if side is None and not step.stop:
             u = float(scale.to_unit(step.estimate))
             side = -1 if u <= lo_u + 1e-9 else 1 if u >= hi_u - 1e-9 else None
-        if side is None and not step.stop:
-            # the interval (not the estimate) ends on the limit: what lies past it is unmeasured
-            # (M3-dry rolling, 2026-12-03: 0.1296 [0.1025, 0.2534], the limit 0.1025 run 8 times)
-            low_u, high_u = float(scale.to_unit(step.low)), float(scale.to_unit(step.high))
-            side = -1 if low_u <= lo_u + 1e-9 else 1 if high_u >= hi_u - 1e-9 else None
+            if side is None:
+                # the interval, not the estimate, ends on the limit: what lies past it is unmeasured
+                # (M3-dry rolling, 2026-12-03: 0.1296 [0.1025, 0.2534], the limit 0.1025 run 8 times)
+                low_u, high_u = float(scale.to_unit(step.low)), float(scale.to_unit(step.high))
+                side = -1 if low_u <= lo_u + 1e-9 else 1 if high_u >= hi_u - 1e-9 else None
         if side is None:
             return None
         limit = lo_u if side < 0 else hi_u
@@ -120,11 +130,7 @@ def run(study, material, st):
         return float(scale.from_unit(0.5 * (limit + nearest)))
 
     def decide(runs):
-        return step_1d(scale, xs, ys, target.value, p["increasing"],
-                       tolerance=None if p["tolerance_is_percent"] else p["tolerance"],
-                       tolerance_percent=p["tolerance"] if p["tolerance_is_percent"] else None,
-                       standard_error=target.standard_error, band=target.band, runs_left=runs,
-                       runs_per_point=n, lo_u=lo_u, hi_u=hi_u, standard_error_dof=target.standard_error_dof)
+        return decide_step(p, scale, xs, ys, target, runs, n, lo_u, hi_u)
 
     while (x := jr.next_recorded()) is not None:        # a resumed study: the same points again
         point(x, replay=True)

@@ -110,7 +110,7 @@ class TiltRecorder:
         self.n = max(1, int(round(record_interval_s / O.dt)))
         self.dt_chunk = self.n * O.dt
         self.x0 = cell.slide_point()[0]
-        self.ori0 = Quaternion(O.bodies[cell.id].state.ori)
+        self.ori0 = Quaternion(cell.body.state.ori)
         self.t0 = O.time
         self.gap0 = cell.bottom_z()
         self.min_gap = self.gap0
@@ -124,7 +124,7 @@ class TiltRecorder:
     def rotation_deg(self):
         """How far the cell has turned since the recorder started (deg, any axis): 0 while its
         rotations are blocked (sliding_cell_rotations: blocked)."""
-        turn = O.bodies[self.cell.id].state.ori * self.ori0.conjugate()
+        turn = self.cell.body.state.ori * self.ori0.conjugate()
         angle = abs(math.degrees(turn.toAxisAngle()[1])) % 360.0
         return min(angle, 360.0 - angle)
 
