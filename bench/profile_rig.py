@@ -2,10 +2,13 @@
 O.step() loops against the Python work between them (rest checks, guards, servo, records,
 measurement and outputs).
 
-    yade -j1 -x -n bench/profile_rig.py job.json [out.json]
+    cp runs/<rig>/<job id>/job.json /tmp/prof/ && cd /tmp/prof
+    PYTHONPATH=<repo root> yade -j1 -x -n <repo root>/bench/profile_rig.py job.json [out.json]
 
-(the repo root on PYTHONPATH, as pycal.runner.yade_env() sets it; `bench/profile.py`
-makes the job and runs this). Writes out.json (default profile.json next to the job):
+job.json: the one in any job folder a study or `pycal run` wrote, copied to an empty
+folder first: the rig runs again and writes its outputs next to it (in the job folder
+itself it would overwrite the cached result). Writes out.json (default profile.json
+next to the job):
 {'wall_s', 'cpu_s', 'steps', 'engines_s': {label: s}, 'engine_shares': {label: fraction},
 'step_loop_s', 'step_loop_cpu_s', 'python_between_s', 'python_between_cpu_s', 'result': the
 rig's measurements}. The engines' execTime is wall-clock time: on a loaded machine read
