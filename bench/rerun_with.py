@@ -2,7 +2,7 @@
 measured on exactly the runs a stage made).
 
     /usr/bin/python3 bench/rerun_with.py RUNS_DIR --rig internal_friction --material M3-wet \
-        --set rig.procedure.tilt_rate_deg_s=5.0 --out runs/bench_wet_tilt
+        --set rig.procedure.tilt_rate_deg_s=5.0 --out runs/bench_wet_tilt [--seeds 1-9]
 
 Every job of RUNS_DIR/<rig>/<rig>-<material>-s<seed>-*/job.json (every seed there) is rebuilt from its
 recorded overrides (the rebuilt job id must equal the recorded one: the same job), run
@@ -34,6 +34,14 @@ def rebuilt(job_file, extra):
     return same, resolve_job(j["rig"], j["material"], dict(j["overrides"], **extra), seed=j["seed"])
 
 
+def seed_list(text):
+    """'1-9' -> {1, ..., 9}; '1,4,7' -> {1, 4, 7}."""
+    if "-" in text:
+        first, last = (int(v) for v in text.split("-", 1))
+        return set(range(first, last + 1))
+    return {int(v) for v in text.split(",")}
+
+
 def response(result, name):
     if name == "friction_angle_offset_deg":
         from pycal.post.friction import friction_angle_offset_deg
@@ -50,9 +58,13 @@ def main(argv=None):
     ap.add_argument("--out", required=True)
     ap.add_argument("--response", default="friction_angle_offset_deg")
     ap.add_argument("--workers", type=int, default=2)
+    ap.add_argument("--seeds", default=None, help="only these seeds: FIRST-LAST or a comma list (default: every seed)")
     args = ap.parse_args(argv)
     extra = {k: yaml.safe_load(v) for k, v in (s.split("=", 1) for s in args.set)}
     files = sorted(Path(args.runs, args.rig).glob(f"{args.rig}-{args.material}-s*/job.json"))
+    if args.seeds:
+        wanted = seed_list(args.seeds)
+        files = [f for f in files if json.loads(f.read_text())["seed"] in wanted]
     pairs = [rebuilt(f, extra) for f in files]
     before = LocalPool(runs_dir=args.runs, workers=1, progress=False).run([b for b, _ in pairs])   # cached
     after = LocalPool(runs_dir=args.out, workers=args.workers).run([a for _, a in pairs])
