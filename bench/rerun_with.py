@@ -7,7 +7,8 @@ measured on exactly the runs a stage made).
 Every job of RUNS_DIR/<rig>/<rig>-<material>-s<seed>-*/job.json (every seed there) is rebuilt from its
 recorded overrides (the rebuilt job id must equal the recorded one: the same job), run
 again with the --set overrides added, and compared: per run the stage responses
-`friction_angle_offset_deg` (friction rigs) or the result keys named by --response, the
+--response (default `friction_angle_offset_deg`: a stage response of pycal.post.responses, a
+vector one as its mean over the steps, or a scalar result key) and mu_static per step, the
 CPU seconds, and per group of equal overrides the paired difference and its standard
 error. Output: the table on stdout.
 """
@@ -34,6 +35,10 @@ def rebuilt(job_file, extra):
     return same, resolve_job(j["rig"], j["material"], dict(j["overrides"], **extra), seed=j["seed"])
 
 
+def _fmt(values):
+    return "/".join("-" if v is None else f"{v:.3f}" for v in values)
+
+
 def seed_list(text):
     """'1-9' -> {1, ..., 9}; '1,4,7' -> {1, 4, 7}."""
     if "-" in text:
@@ -43,10 +48,18 @@ def seed_list(text):
 
 
 def response(result, name):
-    if name == "friction_angle_offset_deg":
-        from pycal.post.friction import friction_angle_offset_deg
-        return friction_angle_offset_deg(result)
-    return result.get(name)
+    """A stage response (pycal.post.responses; a vector one, e.g. friction_band_z_mu_static,
+    as the mean over its steps) or a scalar result key."""
+    from pycal import LAB_DIR
+    from pycal.post import responses
+    r = responses.get(name)
+    if r is None:
+        return result.get(name)
+    value = r.value(result, LAB_DIR)
+    if r.vector:
+        got = [v for v in value if v is not None]
+        return sum(got) / len(got) if got else math.nan
+    return value
 
 
 def main(argv=None):
@@ -75,7 +88,9 @@ def main(argv=None):
         key = json.dumps({k: v for k, v in b_job["overrides"].items() if not isinstance(v, (dict, list))},
                          sort_keys=True)
         groups.setdefault(key, []).append((rb, ra, cb, ca))
-        print(f"seed {b_job['seed']}: {args.response} {rb:.4g} -> {ra:.4g}; CPU {cb:.0f} -> {ca:.0f} s")
+        steps = "".join(f"; mu_static {_fmt(b.get('mu_static'))} -> {_fmt(a.get('mu_static'))}"
+                        for _ in [0] if isinstance(b.get("mu_static"), list))
+        print(f"seed {b_job['seed']}: {args.response} {rb:.4g} -> {ra:.4g}; CPU {cb:.0f} -> {ca:.0f} s{steps}")
     for key, rows in groups.items():
         d = [ra - rb for rb, ra, _, _ in rows]
         se = statistics.stdev(d) / math.sqrt(len(d)) if len(d) > 1 else math.nan
