@@ -1,14 +1,17 @@
 """Replay a study's one-parameter stages from its runs.csv: the interval after each point.
 
     /usr/bin/python3 bench/stage_replay.py STUDY_DIR [--config configs/calibrations/zinc_ore.yaml]
+        [--out-of-reach-factor F]
 
 STUDY_DIR is a study's output folder (runs/study/zinc_ore). Each 1-D stage's runs are fed,
 point by point in the order they ran, to the same decision the study made
 (pycal.calibration.stage_1d.decide_step, the stage's target, tolerance and budget from the config):
 estimate, 95 % interval, interval half-width / tolerance, the stop reason and the next point
 it asks for. No YADE run. The limits a refused point sets are not replayed (a stage with a
-refused point shows the bounds' view). Used to find runs a stage spent without learning
-(bench/README.md, "Runs a stage spent without learning").
+refused point shows the bounds' view). --out-of-reach-factor F replays every stage as if it
+had `out_of_reach_factor: F` (pycal.stats.stopping, rule 3; default: each stage's own). Used
+to find runs a stage spent without learning (bench/README.md, "Runs a stage spent without
+learning").
 """
 import argparse
 import csv
@@ -45,7 +48,7 @@ def points_of(rows, key, per_point):
     return out
 
 
-def replay(study, rows, out=print):
+def replay(study, rows, out=print, out_of_reach_factor=None):
     for mat, stages in study.cfg["materials"].items():
         for st in stages:
             if st["kind"] in ("joint", "inherit"):
@@ -62,7 +65,9 @@ def replay(study, rows, out=print):
                 ys += vals
                 line = f"  {x:.4g}: {np.mean(vals):.4g} (n {len(xs)})"
                 if len(set(xs)) >= 2:
-                    s = decide_step(p, scale, xs, ys, tgt, st["max_runs_count"] - len(xs), n)
+                    factor = out_of_reach_factor if out_of_reach_factor is not None else st["out_of_reach_factor"]
+                    s = decide_step(p, scale, xs, ys, tgt, st["max_runs_count"] - len(xs), n,
+                                    out_of_reach_factor=factor)
                     hw = max(s.estimate - s.low, s.high - s.estimate)
                     nxt = "-" if s.next_x is None else f"{s.next_x:.4g}"
                     line += (f" -> {s.estimate:.4g} [{s.low:.4g}, {s.high:.4g}], half-width / tolerance "
@@ -75,6 +80,7 @@ def main(argv=None):
     ap.add_argument("study_dir", type=Path)
     ap.add_argument("--config", type=Path, default=Path(__file__).resolve().parent.parent
                     / "configs" / "calibrations" / "zinc_ore.yaml")
+    ap.add_argument("--out-of-reach-factor", type=float, default=None)
     a = ap.parse_args(argv)
     runs_csv = a.study_dir / "runs.csv"
     if not runs_csv.is_file():
@@ -83,7 +89,7 @@ def main(argv=None):
     with open(runs_csv, newline="") as fh:
         rows = list(csv.DictReader(fh))
     with tempfile.TemporaryDirectory() as tmp:
-        replay(Study(a.config, _NoRuns(), tmp, log=lambda *_: None), rows)
+        replay(Study(a.config, _NoRuns(), tmp, log=lambda *_: None), rows, out_of_reach_factor=a.out_of_reach_factor)
     return 0
 
 

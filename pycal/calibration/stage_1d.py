@@ -45,14 +45,16 @@ def _slope_per_u(st, scale, x0, y0):
     return slope if p["increasing"] else -slope
 
 
-def decide_step(p, scale, xs, ys, target, runs_left, runs_per_point, lo_u=0.0, hi_u=1.0):
+def decide_step(p, scale, xs, ys, target, runs_left, runs_per_point, lo_u=0.0, hi_u=1.0, out_of_reach_factor=None):
     """The stage's decision after its runs (xs, ys): step_1d with the stage parameter p's
-    tolerance and the Target's value, band and standard error (also bench/stage_replay.py)."""
+    tolerance, the Target's value, band and standard error and the stage's
+    out_of_reach_factor (None: off) (also bench/stage_replay.py)."""
     return step_1d(scale, xs, ys, target.value, p["increasing"],
                    tolerance=None if p["tolerance_is_percent"] else p["tolerance"],
                    tolerance_percent=p["tolerance"] if p["tolerance_is_percent"] else None,
                    standard_error=target.standard_error, band=target.band, runs_left=runs_left,
-                   runs_per_point=runs_per_point, lo_u=lo_u, hi_u=hi_u, standard_error_dof=target.standard_error_dof)
+                   runs_per_point=runs_per_point, lo_u=lo_u, hi_u=hi_u, standard_error_dof=target.standard_error_dof,
+                   out_of_reach_factor=out_of_reach_factor)
 
 
 def run(study, material, st):
@@ -130,7 +132,7 @@ def run(study, material, st):
         return float(scale.from_unit(0.5 * (limit + nearest)))
 
     def decide(runs):
-        return decide_step(p, scale, xs, ys, target, runs, n, lo_u, hi_u)
+        return decide_step(p, scale, xs, ys, target, runs, n, lo_u, hi_u, st["out_of_reach_factor"])
 
     while (x := jr.next_recorded()) is not None:        # a resumed study: the same points again
         point(x, replay=True)

@@ -236,7 +236,8 @@ def _one_d(c, st, key, material, mat_cfg, seeds):
     kind = st["stage"]
     _check_removed(c, st, key)
     c.keys(st, key, ["stage", "rig", "parameter"] + ([] if kind == "density" else ["response"]),
-           ["name", "response", "target", "rig_overrides", "run_at", "set", "max_runs_count", "lab_dir"])
+           ["name", "response", "target", "rig_overrides", "run_at", "set", "max_runs_count", "lab_dir",
+            "out_of_reach_factor"])
     _check_overrides(c, st, key, material, mat_cfg)
     response = _response(c, st.get("response", "bulk_density_kg_m3"), f"{key}.response")
     _rig_response(c, st["rig"], response, key)
@@ -250,6 +251,10 @@ def _one_d(c, st, key, material, mat_cfg, seeds):
            "parameter": _parameter(c, st["parameter"], f"{key}.parameter", material, mat_cfg, kind, True)}
     out["max_runs_count"] = int(c.number(st.get("max_runs_count", DEFAULT_POINTS_COUNT * seeds),
                                          f"{key}.max_runs_count", 2 * seeds))
+    # give up when the tolerance is out of reach in the budget (pycal.stats.stopping, rule 3);
+    # below 1 it would stop stages that can still be met
+    factor = st.get("out_of_reach_factor")
+    out["out_of_reach_factor"] = None if factor is None else c.number(factor, f"{key}.out_of_reach_factor", 1.0)
     return out
 
 

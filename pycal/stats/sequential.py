@@ -53,11 +53,13 @@ def second_point_u(u0, y0, target, increasing, slope_per_u=None, lo_u=0.0, hi_u=
 
 @single_threaded
 def step_1d(scale, x, y, target, increasing, tolerance=None, tolerance_percent=None, standard_error=0.0,
-            band=0.0, runs_left=None, runs_per_point=3, lo_u=0.0, hi_u=1.0, seed=0, standard_error_dof=math.inf):
+            band=0.0, runs_left=None, runs_per_point=3, lo_u=0.0, hi_u=1.0, seed=0, standard_error_dof=math.inf,
+            out_of_reach_factor=None):
     """Decide after the runs (x, y) of a 1-D stage (at least two distinct x).
 
     tolerance: in x's unit, or tolerance_percent of the estimate; lo_u, hi_u: the bounds
-    in use (narrower than the scale's when the rig refused a point)."""
+    in use (narrower than the scale's when the rig refused a point); out_of_reach_factor:
+    stop when the tolerance is out of reach in runs_left (pycal.stats.stopping, rule 3)."""
     u = scale.to_unit(np.asarray(x, dtype=float))
     model = ResponseModel(u[:, None], y)
     inv = invert(model, target, increasing, standard_error=standard_error, band=band, lo_u=lo_u, hi_u=hi_u,
@@ -71,7 +73,8 @@ def step_1d(scale, x, y, target, increasing, tolerance=None, tolerance_percent=N
                                 ran_at_lower=bool(np.any(u <= lo_u + edge)),
                                 ran_at_upper=bool(np.any(u >= hi_u - edge)),
                                 runs_left=runs_left, runs_next=runs_per_point, points_count=len(np.unique(u)),
-                                points=[v for v, _ in points])
+                                points=[v for v, _ in points], runs_done=len(xa),
+                                out_of_reach_factor=out_of_reach_factor)
     out = Step1D(est, low, high, tol, inv.p_below, inv.p_above,
                  float(scale.from_unit(inv.band_low_u)) if band else float("nan"),
                  float(scale.from_unit(inv.band_high_u)) if band else float("nan"), stop=stop, model=model)

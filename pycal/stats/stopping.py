@@ -13,7 +13,13 @@ A stage stops when (checked in this order)
   2. "target beyond the upper/lower bound": at least 97.5 % of the draws point past
      that bound and a point has been run at it: what the bounds allow cannot reach
      the target;
-  3. "run budget spent": the next point would need more runs than the budget left.
+  3. "tolerance out of reach in the run budget" (only where a stage asks for it, with a
+     factor): the interval's half-width, shrunk as 1 / sqrt(runs) over the runs the
+     budget leaves, would still be above factor x the tolerance (at least MIN_POINTS
+     points run). A noisy response that hardly follows the parameter (the dry fines'
+     internal-friction cell: half-width 2.2 x the tolerance after 9 of 15 runs, 1.6 x
+     after 15) spends its budget without reaching it;
+  4. "run budget spent": the next point would need more runs than the budget left.
 Only the first counts as met. The 1-D driver adds "next point already run at length".
 """
 import math
@@ -24,6 +30,7 @@ STUDY_BUDGET = "study run budget spent"      # the whole study's max_runs_count 
 BEYOND_UPPER = "target beyond the upper bound"
 BEYOND_LOWER = "target beyond the lower bound"
 REPEATS = "next point already run at length"   # said by the driver (pycal.calibration.stage_1d)
+OUT_OF_REACH = "tolerance out of reach in the run budget"
 BOUND_SHARE = 0.025
 MIN_POINTS = 3
 
@@ -51,10 +58,19 @@ def unmeasured_side(estimate, low, high, points):
     return 1 if gap_above > gap_below else -1
 
 
+def projected_half_width(half_width, runs_done, runs_left):
+    """The half-width after runs_left more runs if it shrinks as 1 / sqrt(runs): a point
+    estimate's standard error does; an interval that still moves with the design can shrink
+    faster (an optimistic bound early in a stage, hence a factor above 1 for the rule)."""
+    return half_width * math.sqrt(runs_done / (runs_done + runs_left))
+
+
 def stop_reason(estimate, low, high, tolerance, p_below=0.0, p_above=0.0, ran_at_lower=False,
-                ran_at_upper=False, runs_left=None, runs_next=0, points_count=MIN_POINTS, points=None):
+                ran_at_upper=False, runs_left=None, runs_next=0, points_count=MIN_POINTS, points=None,
+                runs_done=None, out_of_reach_factor=None):
     """The reason to stop now (one of the constants above), or None to go on. points: the
-    distinct parameter values run (None: not checked)."""
+    distinct parameter values run (None: not checked); out_of_reach_factor (None: rule 3
+    off) needs runs_done and runs_left."""
     measured = points is None or unmeasured_side(estimate, low, high, points) == 0
     if (p_below <= BOUND_SHARE and p_above <= BOUND_SHARE and points_count >= MIN_POINTS
             and within_tolerance(estimate, low, high, tolerance) and measured):
@@ -63,6 +79,10 @@ def stop_reason(estimate, low, high, tolerance, p_below=0.0, p_above=0.0, ran_at
         return BEYOND_UPPER
     if p_below >= 1 - BOUND_SHARE and ran_at_lower:
         return BEYOND_LOWER
+    if (out_of_reach_factor is not None and runs_left is not None and runs_done and points_count >= MIN_POINTS
+            and projected_half_width(max(estimate - low, high - estimate), runs_done, runs_left)
+            > out_of_reach_factor * tolerance):
+        return OUT_OF_REACH
     if runs_left is not None and runs_left < runs_next:
         return BUDGET
     return None

@@ -276,6 +276,10 @@ STUDY_CASES = [
     ("start: 0.35", "start: 3.5", "materials.M2[0].parameter.start", "outside bounds"),
     ("seeds_count: 2", "seeds_count: 0", "seeds_count", ""),
     ("sample: gravel_dry", "sample: gravle_dry", "materials.M2[0].target", "gravle_dry"),
+    ("      response: aor_mean_deg\n", "      response: aor_mean_deg\n      out_of_reach_factor: 0.5\n",
+     "materials.M2[0].out_of_reach_factor", "must be >= 1"),
+    ("      response: aor_mean_deg\n", "      response: aor_mean_deg\n      out_of_reach_factor: soon\n",
+     "materials.M2[0].out_of_reach_factor", "must be a number"),
 ]
 
 

@@ -16,7 +16,8 @@ AOR = staticmethod(lambda x: 48 - 28 * np.exp(-2.5 * x))     # AoR (deg) vs roll
 AOR_ROOT = -math.log((48 - 38) / 28) / 2.5                   # 0.412: AoR 38 deg
 
 
-def run_1d(f, scale, x0, target, noise_sd, tolerance, budget, rng, seeds=3, increasing=True, target_se=0.0):
+def run_1d(f, scale, x0, target, noise_sd, tolerance, budget, rng, seeds=3, increasing=True, target_se=0.0,
+           out_of_reach_factor=None):
     """The 1-D loop of a stage, with a toy response: (last step, runs used, points run)."""
     xs, ys, points = [], [], []
 
@@ -30,7 +31,7 @@ def run_1d(f, scale, x0, target, noise_sd, tolerance, budget, rng, seeds=3, incr
     run(float(scale.from_unit(u1)))
     while True:
         st = step_1d(scale, xs, ys, target, increasing, tolerance=tolerance, runs_left=budget - len(xs),
-                     runs_per_point=seeds, standard_error=target_se)
+                     runs_per_point=seeds, standard_error=target_se, out_of_reach_factor=out_of_reach_factor)
         if st.stop:
             return st, len(xs), points
         run(float(f"{st.next_x:.4g}"))
@@ -45,6 +46,33 @@ def test_stop_rule():
     assert stopping.stop_reason(1.5, 1.5, 1.5, 0.03, p_above=1.0, ran_at_upper=True) == stopping.BEYOND_UPPER
     assert stopping.stop_reason(1.5, 1.5, 1.5, 0.03, p_above=1.0, ran_at_upper=False, runs_left=9,
                                 runs_next=3) is None
+
+
+def test_out_of_reach_projects_the_half_width_over_the_runs_left():
+    # half-width 0.1 after 9 runs, 6 left: 0.1 sqrt(9 / 15) = 0.0775 at the end
+    assert stopping.projected_half_width(0.1, 9, 6) == pytest.approx(0.1 * math.sqrt(0.6))
+    kw = dict(runs_left=6, runs_next=3, runs_done=9)
+    assert stopping.stop_reason(0.3, 0.2, 0.4, 0.03, **kw) is None                       # rule off
+    assert stopping.stop_reason(0.3, 0.2, 0.4, 0.03, out_of_reach_factor=1.5, **kw) == stopping.OUT_OF_REACH
+    assert stopping.stop_reason(0.3, 0.2, 0.4, 0.03, out_of_reach_factor=3.0, **kw) is None   # 0.0775 < 0.09
+    assert stopping.stop_reason(0.3, 0.2, 0.4, 0.03, out_of_reach_factor=1.5, points_count=2, **kw) is None
+
+
+@pytest.mark.parametrize("noise_sd, reachable", [(0.25, False), (0.04, True)])
+def test_out_of_reach_stops_early_only_where_the_budget_cannot_reach_the_tolerance(noise_sd, reachable):
+    """A line of slope 0.58 (the internal-friction cell's offset per unit of particle
+    friction), tolerance 0.08, budget 15 runs: a root found from n runs at the root has a
+    half-width of about 1.96 sd / (0.58 sqrt(n)): 0.21 for sd 0.25 at n = 15 (out of reach:
+    2.6 x the tolerance), 0.033 for sd 0.04 (within it)."""
+    f = lambda x: 0.58 * (x - 0.4)      # noqa: E731  root 0.4
+    scale, budget = Scale(0.05, 1.5), 15
+    for seed in range(5):
+        rng = np.random.default_rng(seed)
+        on = run_1d(f, scale, 0.5, 0.0, noise_sd, 0.08, budget, rng, out_of_reach_factor=1.5)
+        if reachable:
+            assert on[0].stop != stopping.OUT_OF_REACH
+        else:
+            assert on[0].stop == stopping.OUT_OF_REACH and on[1] < budget
 
 
 def test_second_point_uses_the_slope_or_steps_towards_the_target():

@@ -17,6 +17,7 @@ from fake_rigs import FakeRigs, holds, stiffness_result, wall_result, YADE_VERSI
 from pycal import labdata
 from pycal.calibration.study import Study
 from pycal.calibration.study_config import load_study
+from pycal.stats import stopping
 from pycal.configs import validate_material, material_names, load_boundaries
 from pycal.errors import ConfigError, RunError
 from pycal.report import write_report
@@ -576,8 +577,9 @@ def test_calibrate_and_fit_density_commands_run_on_a_fake_executor(tmp_path, stu
     assert code == 0 and abs(estimate - rho_truth) < 50 and "95 % interval" in out
 
 
-def rolling_study(tmp_path, tolerance, max_runs):
-    """A one-stage study: the M3-dry rolling resistance on the dry fines' AoR, start 0.35."""
+def rolling_study(tmp_path, tolerance, max_runs, extra=""):
+    """A one-stage study: the M3-dry rolling resistance on the dry fines' AoR, start 0.35
+    (extra: more stage keys, one YAML line)."""
     cfg = tmp_path / "rolling.yaml"
     cfg.write_text(f"""
 name: rolling
@@ -595,6 +597,7 @@ materials:
         response_increases: true
         tolerance_coefficient: {tolerance}
       max_runs_count: {max_runs}
+      {extra}
 """)
     return cfg
 
@@ -683,6 +686,26 @@ def test_a_stage_does_not_spend_its_budget_on_the_limit_it_cannot_pass(tmp_path)
     xs = [eta(j) for j in ex.asked]
     assert max(xs.count(x) for x in set(xs)) <= 9, sorted(xs)
     assert any(x < 0.1025 for x in xs if x != 0.02)        # probed past the limit 0.1025 (refused or not)
+
+
+def test_a_stage_that_cannot_reach_its_tolerance_stops_early_when_its_config_says_so(tmp_path):
+    """A pile that hardly follows the rolling resistance (AoR = 30 + 20 x rolling, seed noise
+    10 deg, tolerance 0.05): a root found from n runs has a half-width of about
+    1.96 x 10 / (20 sqrt(n)) = 0.16 at the budget's 36 runs, 3 x the tolerance. With
+    out_of_reach_factor 1.5 the stage stops, not met, before its budget; without it, it
+    spends the budget."""
+    def eta(j):
+        return j["materials"]["M3-dry"]["interactions"]["M3-dry"]["rolling_resistance_coefficient"]
+
+    rows = {}
+    for name, extra in (("on", "out_of_reach_factor: 1.5"), ("off", "")):
+        (tmp_path / name).mkdir()
+        ex = FakeRigs(results={"aor": lambda j: {"aor_mean_deg": 30.0 + 20.0 * eta(j)}}, noise={"aor_mean_deg": 10.0})
+        (row,) = Study(rolling_study(tmp_path / name, 0.05, 36, extra), ex, tmp_path / name / "out", log=quiet).run()
+        rows[name] = (row, len(ex.asked))
+    (on, runs_on), (off, runs_off) = rows["on"], rows["off"]
+    assert on["stop_reason"] == stopping.OUT_OF_REACH and not on["met"] and runs_on < 36
+    assert off["stop_reason"] != stopping.OUT_OF_REACH and runs_off > runs_on
 
 
 def test_report_shows_pictures_held_values_both_verdicts_and_provenance(tmp_path, study_file):
