@@ -9,7 +9,8 @@ recorded overrides (the rebuilt job id must equal the recorded one: the same job
 again with the --set overrides added, and compared: per run the stage responses
 --response (default `friction_angle_offset_deg`: a stage response of pycal.post.responses, a
 vector one as its mean over the steps, or a scalar result key) and mu_static per step, the
-CPU seconds, and per group of equal overrides the paired difference and its standard
+time steps (the cost: CPU seconds of one job vary with the machine's load, its time steps
+do not) and the CPU seconds as recorded, and per group of equal overrides the paired difference and its standard
 error. Output: the table on stdout.
 """
 import argparse
@@ -33,6 +34,13 @@ def rebuilt(job_file, extra):
     if same["job_id"] != j["job_id"]:
         raise SystemExit(f"{job_file}: rebuilt as {same['job_id']}, not the same job (configs changed since?)")
     return same, resolve_job(j["rig"], j["material"], dict(j["overrides"], **extra), seed=j["seed"])
+
+
+def time_steps(result):
+    """The run's time steps, all phases (provenance.phase_cpu): its cost, the same on a quiet
+    or a loaded machine (the CPU seconds of one job vary by up to 1.45x between two main
+    jobs on this machine, the steps not at all)."""
+    return sum(ph["steps_count"] for ph in result["provenance"]["phase_cpu"].values())
 
 
 def _fmt(values):
@@ -84,20 +92,21 @@ def main(argv=None):
     groups = {}
     for (b_job, _), b, a in zip(pairs, before, after):
         rb, ra = response(b, args.response), response(a, args.response)
-        cb, ca = b["provenance"]["cpu_time_s"], a["provenance"]["cpu_time_s"]
+        cb, ca = time_steps(b), time_steps(a)
         key = json.dumps({k: v for k, v in b_job["overrides"].items() if not isinstance(v, (dict, list))},
                          sort_keys=True)
         groups.setdefault(key, []).append((rb, ra, cb, ca))
         steps = "".join(f"; mu_static {_fmt(b.get('mu_static'))} -> {_fmt(a.get('mu_static'))}"
                         for _ in [0] if isinstance(b.get("mu_static"), list))
-        print(f"seed {b_job['seed']}: {args.response} {rb:.4g} -> {ra:.4g}; CPU {cb:.0f} -> {ca:.0f} s{steps}")
+        print(f"seed {b_job['seed']}: {args.response} {rb:.4g} -> {ra:.4g}; time steps {cb:.4g} -> {ca:.4g} "
+              f"({ca / cb:.2f}); CPU {b['provenance']['cpu_time_s']:.0f} -> {a['provenance']['cpu_time_s']:.0f} s{steps}")
     for key, rows in groups.items():
         d = [ra - rb for rb, ra, _, _ in rows]
         se = statistics.stdev(d) / math.sqrt(len(d)) if len(d) > 1 else math.nan
         sd = statistics.stdev([r[0] for r in rows]) if len(rows) > 1 else math.nan
         print(f"{key}\n  n {len(d)}: before {statistics.fmean(r[0] for r in rows):.4g} (seed SD {sd:.3g}), after "
               f"{statistics.fmean(r[1] for r in rows):.4g}; paired difference {statistics.fmean(d):+.3g} +- {se:.2g}; "
-              f"CPU median {statistics.median(r[2] for r in rows):.0f} -> {statistics.median(r[3] for r in rows):.0f} s")
+              f"time steps after / before, median {statistics.median(r[3] / r[2] for r in rows):.2f}")
 
 
 if __name__ == "__main__":
