@@ -96,10 +96,11 @@ def main(argv=None):
         key = json.dumps({k: v for k, v in b_job["overrides"].items() if not isinstance(v, (dict, list))},
                          sort_keys=True)
         groups.setdefault(key, []).append((rb, ra, cb, ca))
-        steps = "".join(f"; mu_static {_fmt(b.get('mu_static'))} -> {_fmt(a.get('mu_static'))}"
-                        for _ in [0] if isinstance(b.get("mu_static"), list))
+        per_step = ""
+        if isinstance(b.get("mu_static"), list):
+            per_step = f"; mu_static {_fmt(b['mu_static'])} -> {_fmt(a['mu_static'])}"
         print(f"seed {b_job['seed']}: {args.response} {rb:.4g} -> {ra:.4g}; time steps {cb:.4g} -> {ca:.4g} "
-              f"({ca / cb:.2f}); CPU {b['provenance']['cpu_time_s']:.0f} -> {a['provenance']['cpu_time_s']:.0f} s{steps}")
+              f"({ca / cb:.2f}); CPU {b['provenance']['cpu_time_s']:.0f} -> {a['provenance']['cpu_time_s']:.0f} s{per_step}")
     for key, rows in groups.items():
         d = [ra - rb for rb, ra, _, _ in rows]
         se = statistics.stdev(d) / math.sqrt(len(d)) if len(d) > 1 else math.nan
