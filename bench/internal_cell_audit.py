@@ -1,13 +1,16 @@
 """Why does the internal-friction cell read high? One suspect changed at a time (issue 28).
 
     /usr/bin/python3 bench/internal_cell_audit.py RUNS_DIR [--material M3-dry] \
-        [--frictions 0.1,0.5] [--seeds 5] [--suspects all] [--workers 1] [--table-only] [--out table.md]
+        [--frictions 0.1,0.5] [--rolling 0.35,0.7] [--seeds 5] [--suspects all] [--workers 1] \
+        [--table-only] [--out table.md]
 
 Runs `pycal run internal_friction` (cached: a stopped audit resumes) at the dry fines'
 internal-friction stage's own settings (configs/calibrations/zinc_ore.yaml: its
 rig_overrides, and E 1e8 Pa, the calibrated stiffness), for every particle friction in
---frictions and every suspect below, on seeds 1..--seeds, then prints per suspect and
-friction: mu_static per consolidation step and the stage's response (the mean offset from
+--frictions (and every rolling resistance in --rolling, set on the material and on the
+steel and PVC walls as the study's rolling stage sets it; without --rolling the material's
+start value) and every suspect below, on seeds 1..--seeds, then prints per suspect,
+friction and rolling resistance: mu_static per consolidation step and the stage's response (the mean offset from
 the lab curve over the steps >= 10 kPa, pycal.post.friction.friction_offset) with their
 seed SD, the change against the baseline (the rig as the study runs it) +- its standard
 error (the fills differ, so unpaired), and the median CPU per run.
@@ -67,35 +70,46 @@ def stage_overrides(material):
     raise SystemExit(f"{STUDY}: no stage {STAGE!r} for {material}")
 
 
-def settings(material, friction, suspect):
-    """The --set overrides of one audit point."""
+def rolling_keys(material):
+    """The keys the study's rolling-resistance stage sets together: the material's own and the walls'."""
+    return [f"interactions.{material}.rolling_resistance_coefficient",
+            "interactions.steel.rolling_resistance_coefficient",
+            "interactions.pvc.rolling_resistance_coefficient"]
+
+
+def settings(material, friction, suspect, rolling=None):
+    """The --set overrides of one audit point (rolling None: the material's start value)."""
     ov = dict(stage_overrides(material))          # a copy: the cached dict stays as read
     ov["contact.youngs_modulus_pa"] = YOUNGS_MODULUS_PA
     ov[f"interactions.{material}.friction_coefficient"] = friction
+    if rolling is not None:
+        ov.update({k: rolling for k in rolling_keys(material)})
     ov.update(SUSPECTS[suspect])
     return ov
 
 
-def run_point(runs, material, friction, suspect, seeds, workers):
+def run_point(runs, material, friction, suspect, seeds, workers, rolling=None):
     cmd = [sys.executable, "-m", "pycal", "run", "internal_friction", "--material", material,
            "--seeds", str(seeds), "--workers", str(workers), "--out", str(runs)]
-    for k, v in settings(material, friction, suspect).items():
+    for k, v in settings(material, friction, suspect, rolling).items():
         cmd += ["--set", f"{k}={json.dumps(v)}"]
-    print(f"[audit] {suspect} at friction {friction}: {seeds} seeds", flush=True)
+    print(f"[audit] {suspect} at friction {friction}, rolling {'start value' if rolling is None else rolling}: "
+          f"{seeds} seeds", flush=True)
     subprocess.run(cmd, cwd=ROOT, check=True)
 
 
 def suspect_of(overrides, material):
-    """Which suspect a run's overrides are (None: not an audit run)."""
-    for name, ov in SUSPECTS.items():
-        fr = overrides.get(f"interactions.{material}.friction_coefficient")
-        if fr is not None and overrides == settings(material, fr, name):
-            return name, fr
+    """(suspect, friction, rolling resistance or None) of a run's overrides (None: not an audit run)."""
+    fr = overrides.get(f"interactions.{material}.friction_coefficient")
+    rr = overrides.get(rolling_keys(material)[0])
+    for name in SUSPECTS:
+        if fr is not None and overrides == settings(material, fr, name, rr):
+            return name, fr, rr
     return None
 
 
 def load(runs, material):
-    """{(suspect, friction): [result]} of the audit's runs in RUNS_DIR."""
+    """{(suspect, friction, rolling): [result]} of the audit's runs in RUNS_DIR."""
     out = {}
     for path in sorted((Path(runs) / "internal_friction").glob("*/result.json")):
         r = json.loads(path.read_text())
@@ -116,17 +130,19 @@ def offset(r):
 
 
 def table(groups):
-    """Markdown rows: per friction and suspect, mu_static per step, the offset, the change."""
+    """Markdown rows: per friction, rolling resistance and suspect, mu_static per step, the
+    offset, the change against the baseline at the same friction and rolling resistance."""
     stresses = sorted({s for rs in groups.values() for r in rs for s in r["stress_pa"]})
-    head = ("| particle friction | suspect | seeds | " + " | ".join(f"mu_static {s / 1e3:g} kPa" for s in stresses)
+    head = ("| particle friction | rolling resistance | suspect | seeds | " + " | ".join(f"mu_static {s / 1e3:g} kPa" for s in stresses)
             + " | offset from the lab (SD) | change vs baseline +- SE | cell turned at the onset, deg (mean) "
             "| CPU s per run (median) |")
-    lines = [head, "|" + "---|" * (7 + len(stresses))]
-    for fr in sorted({f for _, f in groups}):
-        base = groups.get(("baseline", fr), [])
+    lines = [head, "|" + "---|" * (8 + len(stresses))]
+    points = sorted({(f, rr) for _, f, rr in groups}, key=lambda p: (p[0], -1.0 if p[1] is None else p[1]))
+    for fr, rr in points:
+        base = groups.get(("baseline", fr, rr), [])
         mb, _, seb = mean_sd_se([offset(r) for r in base])
         for name in SUSPECTS:
-            rs = groups.get((name, fr))
+            rs = groups.get((name, fr, rr))
             if not rs:
                 continue
             cells = []
@@ -140,7 +156,7 @@ def table(groups):
             turned = f"{statistics.mean(turns):.2f}" if turns else "-"      # runs before 91c6321 did not record it
             cpu = statistics.median(r["provenance"]["cpu_time_s"] for r in rs)
             stuck = sum(len(step_values(r)[2]) for r in rs)
-            lines.append(f"| {fr} | {name}{f' ({stuck} stuck steps)' if stuck else ''} | {len(rs)} | "
+            lines.append(f"| {fr} | {'start' if rr is None else rr} | {name}{f' ({stuck} stuck steps)' if stuck else ''} | {len(rs)} | "
                          + " | ".join(cells) + f" | {fmt(m)} ({fmt(sd)}) | {change} | {turned} | {cpu:.0f} |")
     return "\n".join(lines)
 
@@ -150,6 +166,7 @@ def main(argv=None):
     ap.add_argument("runs")
     ap.add_argument("--material", default="M3-dry")
     ap.add_argument("--frictions", default="0.1,0.5")
+    ap.add_argument("--rolling", default=None, help="rolling resistances, comma list (default: the material's start value)")
     ap.add_argument("--seeds", type=int, default=5)
     ap.add_argument("--suspects", default="all", help="comma list of " + ", ".join(SUSPECTS))
     ap.add_argument("--workers", type=int, default=1)
@@ -162,10 +179,12 @@ def main(argv=None):
     if unknown:
         raise SystemExit(f"--suspects: unknown {', '.join(unknown)} (known: {', '.join(SUSPECTS)})")
     frictions = [float(f) for f in args.frictions.split(",")]
+    rollings = [float(r) for r in args.rolling.split(",")] if args.rolling else [None]
     if not args.table_only:
         for fr in frictions:
-            for name in names:
-                run_point(args.runs, args.material, fr, name, args.seeds, args.workers)
+            for rr in rollings:
+                for name in names:
+                    run_point(args.runs, args.material, fr, name, args.seeds, args.workers, rr)
     text = table(load(args.runs, args.material))
     print(text)
     if args.out:
