@@ -1,8 +1,8 @@
 """Why does the internal-friction cell read high? One suspect changed at a time (issue 28).
 
     /usr/bin/python3 bench/internal_cell_audit.py RUNS_DIR [--material M3-dry] \
-        [--frictions 0.1,0.5] [--rolling 0.35,0.7] [--seeds 5] [--suspects all] [--workers 1] \
-        [--table-only] [--out table.md]
+        [--frictions 0.1,0.5] [--rolling 0.35,0.7] [--seeds 5] [--suspects all] [--without-baseline] \
+        [--workers 1] [--table-only] [--out table.md]
 
 Runs `pycal run internal_friction` (cached: a stopped audit resumes) at the dry fines'
 internal-friction stage's own settings (configs/calibrations/zinc_ore.yaml: its
@@ -170,11 +170,15 @@ def main(argv=None):
     ap.add_argument("--seeds", type=int, default=5)
     ap.add_argument("--suspects", default="all", help="comma list of " + ", ".join(SUSPECTS))
     ap.add_argument("--workers", type=int, default=1)
+    ap.add_argument("--without-baseline", action="store_true",
+                    help="run only the suspects named (a sweep of one cell; the change column then reads '-')")
     ap.add_argument("--table-only", action="store_true", help="only tabulate the runs already in RUNS_DIR")
     ap.add_argument("--out", default=None, help="also write the table (markdown) here")
     args = ap.parse_args(argv)
     names = list(SUSPECTS) if args.suspects == "all" else ["baseline"] + [
         s for s in args.suspects.split(",") if s != "baseline"]
+    if args.without_baseline:
+        names.remove("baseline")
     unknown = [s for s in names if s not in SUSPECTS]
     if unknown:
         raise SystemExit(f"--suspects: unknown {', '.join(unknown)} (known: {', '.join(SUSPECTS)})")
