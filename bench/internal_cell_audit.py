@@ -10,8 +10,9 @@ rig_overrides, and E 1e8 Pa, the calibrated stiffness), for every particle frict
 --frictions (and every rolling resistance in --rolling, set on the material and on the
 steel and PVC walls as the study's rolling stage sets it; without --rolling the material's
 start value) and every suspect below, on seeds 1..--seeds, then prints per suspect,
-friction and rolling resistance: mu_static per consolidation step and the stage's response (the mean offset from
-the lab curve over the steps >= 10 kPa, pycal.post.friction.friction_offset) with their
+friction and rolling resistance: mu_static per consolidation step and the stage's response
+(the mean offset from the lab curve over the steps >= 10 kPa,
+pycal.post.friction.friction_offset) with their
 seed SD, the change against the baseline (the rig as the study runs it) +- its standard
 error (the fills differ, so unpaired), and the median CPU per run.
 
@@ -45,6 +46,7 @@ from pycal.post.friction import friction_offset  # noqa: E402
 
 STUDY = ROOT / "configs" / "calibrations" / "zinc_ore.yaml"
 STAGE = "internal_friction"
+ROLLING_STAGE = "rolling_resistance"   # the study's stage whose parameter keys set one rolling resistance
 YOUNGS_MODULUS_PA = 1e8            # the stiffness the study's stage runs at (the stiffness stage's bound)
 
 SUSPECTS = {
@@ -60,26 +62,29 @@ SUSPECTS = {
 
 
 @functools.lru_cache(maxsize=None)
+def study_stage(material, label):
+    """The material's stage `label` in the shipped study (read once per material and stage:
+    settings() asks for it for every run it classifies)."""
+    for stage in load_study(STUDY)["materials"][material]:
+        if stage.get("label") == label:
+            return stage
+    raise SystemExit(f"{STUDY}: no stage {label!r} for {material}")
+
+
 def stage_overrides(material):
-    """The rig_overrides of the material's internal-friction stage in the shipped study
-    (read once per material: settings() asks for it for every run it classifies)."""
-    study = load_study(STUDY)
-    for stage in study["materials"][material]:
-        if stage.get("label") == STAGE:
-            return dict(stage.get("rig_overrides") or {})
-    raise SystemExit(f"{STUDY}: no stage {STAGE!r} for {material}")
+    """The rig_overrides of the material's internal-friction stage in the shipped study."""
+    return dict(study_stage(material, STAGE).get("rig_overrides") or {})
 
 
 def rolling_keys(material):
-    """The keys the study's rolling-resistance stage sets together: the material's own and the walls'."""
-    return [f"interactions.{material}.rolling_resistance_coefficient",
-            "interactions.steel.rolling_resistance_coefficient",
-            "interactions.pvc.rolling_resistance_coefficient"]
+    """The keys the study's rolling-resistance stage sets together (the material's own first,
+    then the walls')."""
+    return list(study_stage(material, ROLLING_STAGE)["parameter"]["keys"])
 
 
 def settings(material, friction, suspect, rolling=None):
     """The --set overrides of one audit point (rolling None: the material's start value)."""
-    ov = dict(stage_overrides(material))          # a copy: the cached dict stays as read
+    ov = stage_overrides(material)                # a new dict: the cached stage stays as read
     ov["contact.youngs_modulus_pa"] = YOUNGS_MODULUS_PA
     ov[f"interactions.{material}.friction_coefficient"] = friction
     if rolling is not None:
