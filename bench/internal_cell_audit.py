@@ -4,22 +4,27 @@
         [--frictions 0.1,0.5] [--rolling 0.35,0.7] [--seeds 5] [--suspects all] [--without-baseline] \
         [--workers 1] [--table-only] [--out table.md]
 
-Runs `pycal run internal_friction` (cached: a stopped audit resumes) at the dry fines'
-internal-friction stage's own settings (configs/calibrations/zinc_ore.yaml: its
-rig_overrides, and E 1e8 Pa, the calibrated stiffness), for every particle friction in
+Runs `pycal run internal_friction` (cached: a stopped audit resumes) at the settings the
+dry fines' internal-friction stage ran until it left the study (STAGE_SETTINGS below: 12 and
+90 kPa, static onset only, the faster tilts; and E 1e8 Pa, the calibrated stiffness), for
+every particle friction in
 --frictions (and every rolling resistance in --rolling, set on the material and on the
 steel and PVC walls as the study's rolling stage sets it; without --rolling the material's
 start value) and every suspect below, on seeds 1..--seeds, then prints per suspect,
 friction and rolling resistance: mu_static per consolidation step and the stage's response
 (the mean offset from the lab curve over the steps >= 10 kPa,
 pycal.post.friction.friction_offset) with their
-seed SD, the change against the baseline (the rig as the study runs it) +- its standard
-error (the fills differ, so unpaired), and the median CPU per run.
+seed SD, the change against the baseline (the rig as shipped: since 2026-12-04 the cell
+free to tip, read at its rim; before, the guided cell) +- its standard error (the fills
+differ, so unpaired), and the median CPU per run.
 
-The suspects (each alone; docs/rigs.md "internal_friction"):
-  rotations_free  the mobile cell may turn (procedure.sliding_cell_rotations: free)
-  turning_read_at_rim  the same, its slide read at the centre of its bottom rim, not its
-                  centre of mass (procedure.slide_read_at: shear_plane): tipping is not sliding
+The suspects (each alone, on the rig as shipped; docs/rigs.md "internal_friction"):
+  guided          the mobile cell may not turn (procedure.sliding_cell_rotations: blocked,
+                  slide_read_at: body): the rig until 2026-12-04
+  rotations_free  the mobile cell may turn, its slide read at its centre of mass
+                  (slide_read_at: body): tipping reads as sliding
+  turning_read_at_rim  free to turn, its slide read at the centre of its bottom rim
+                  (slide_read_at: shear_plane): the rig as shipped, named as in the tables
   lid_free        the lid rests free on the contents instead of being joined to the cell
   fine_rim        128 facets instead of 32 round both cells (rim vertices pinch particles)
   onset_3mm       the onset read at 3 mm of slide instead of 1 mm
@@ -45,13 +50,20 @@ from pycal.files import write_text  # noqa: E402
 from pycal.post.friction import friction_offset  # noqa: E402
 
 STUDY = ROOT / "configs" / "calibrations" / "zinc_ore.yaml"
-STAGE = "internal_friction"
+STAGE_SETTINGS = {                 # the dry fines' internal-friction stage as it last ran (af07e0c)
+    "rig.procedure.consolidation_stresses_pa": [12000, 90000],
+    "rig.procedure.measure_dynamic_friction": False,
+    "rig.procedure.pre_tilt_rate_deg_s": 20.0,
+    "rig.procedure.tilt_rate_deg_s": 5.0,
+    "rig.procedure.pre_tilt_slide_fraction": 0.5,
+}
 ROLLING_STAGE = "rolling_resistance"   # the study's stage whose parameter keys set one rolling resistance
 YOUNGS_MODULUS_PA = 1e8            # the stiffness the study's stage runs at (the stiffness stage's bound)
 
 SUSPECTS = {
     "baseline": {},
-    "rotations_free": {"rig.procedure.sliding_cell_rotations": "free"},
+    "guided": {"rig.procedure.sliding_cell_rotations": "blocked", "rig.procedure.slide_read_at": "body"},
+    "rotations_free": {"rig.procedure.sliding_cell_rotations": "free", "rig.procedure.slide_read_at": "body"},
     "turning_read_at_rim": {"rig.procedure.sliding_cell_rotations": "free", "rig.procedure.slide_read_at": "shear_plane"},
     "lid_free": {"rig.procedure.lid_during_tilt": "free"},
     "fine_rim": {"rig.geometry.cell_facet_segments_count": 128},
@@ -71,11 +83,6 @@ def study_stage(material, label):
     raise SystemExit(f"{STUDY}: no stage {label!r} for {material}")
 
 
-def stage_overrides(material):
-    """The rig_overrides of the material's internal-friction stage in the shipped study."""
-    return dict(study_stage(material, STAGE).get("rig_overrides") or {})
-
-
 def rolling_keys(material):
     """The keys the study's rolling-resistance stage sets together (the material's own first,
     then the walls')."""
@@ -84,7 +91,7 @@ def rolling_keys(material):
 
 def settings(material, friction, suspect, rolling=None):
     """The --set overrides of one audit point (rolling None: the material's start value)."""
-    ov = stage_overrides(material)                # a new dict: the cached stage stays as read
+    ov = dict(STAGE_SETTINGS)
     ov["contact.youngs_modulus_pa"] = YOUNGS_MODULUS_PA
     ov[f"interactions.{material}.friction_coefficient"] = friction
     if rolling is not None:

@@ -30,7 +30,7 @@ def test_each_setting_is_found_again_from_its_overrides():
     assert audit.suspect_of(only_material, "M3-dry") is None
     other = dict(audit.settings("M3-dry", 0.5, "baseline"), **{"rig.geometry.cell_gap_m": 0.004})
     assert audit.suspect_of(other, "M3-dry") is None
-    # the stage's own settings, read from the study config, are in every point
+    # the former stage's settings are in every point
     assert audit.settings("M3-dry", 0.5, "lid_free")["rig.procedure.consolidation_stresses_pa"] == [12000, 90000]
 
 

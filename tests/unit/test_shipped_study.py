@@ -1,6 +1,6 @@
 """The shipped study (configs/calibrations/zinc_ore.yaml) from its first stage to its last on
-fake rigs: every stage kind runs (density, rolling resistance, stiffness in log E, wall and
-internal friction, inheritance, the wet cohesion from the wet internal-friction curve, the
+fake rigs: every stage kind runs (density, rolling resistance, stiffness in log E, wall
+friction, inheritance, the wet cohesion from the wet internal-friction curve, the
 wet wall joint fit, the final rolling resistance + density pass), the outputs and the report
 are written. The fake laws are smooth and the noise small: this checks the plumbing of the
 real config, not its numbers (those need YADE)."""
@@ -58,10 +58,10 @@ def ucs(job):
 
 
 def transfer(job):
-    """The transfer chute (application): impact stress 1e5 Pa x the gravel-fines friction of
-    the set (a cross pair the set takes from the fines), design 88.6 kPa, wet fines plug."""
+    """The transfer chute (application): impact stress 1e5 Pa x the fines-steel friction of
+    the set (calibrated on the fines' wall friction curve), design 88.6 kPa, wet fines plug."""
     fines = next(m for m in job["materials"] if m.startswith("M3"))
-    mu = job["materials"]["M2"]["interactions"][fines]["friction_coefficient"]
+    mu = job["materials"][fines]["interactions"]["steel"]["friction_coefficient"]
     return {"impact_stress_pa": 1e5 * mu, "design_impact_stress_pa": 88600.0, "momentum_flux_stress_pa": 41800.0,
             "throughput_in_kg_s": 52.0, "throughput_out_kg_s": 51.0, "holdup_mass_kg": 0.1,
             "plugged": fines == "M3-wet"}
@@ -113,9 +113,9 @@ def test_the_shipped_study_runs_every_stage_on_fake_rigs(tmp_path, fake_stiffnes
     assert all(j["seed"] >= 7 for j in ex.asked if j["rig"] == "aor_mixed")
     fines = next(r for r in study.validation_rows if r["prediction"] == "fines_dry_ucs")
     assert fines["comparisons"][0]["n"] > 0 and fines["comparisons"][0]["inside"]
-    # application: the transfer dry and wet on the calibrated fines' friction
+    # application: the transfer dry and wet on the calibrated fines-steel friction
     dry_t, wet_t = study.application_rows
-    mu = study.overrides["M3-dry"]["interactions.M3-dry.friction_coefficient"]
+    mu = study.overrides["M3-dry"]["interactions.steel.friction_coefficient"]
     assert dry_t["responses"][0]["mean"] == pytest.approx(1e5 * mu)
     assert (wet_t["responses"][-1]["true_count"], dry_t["responses"][-1]["true_count"]) == (3, 0)
     html = write_report(study.out).read_text()

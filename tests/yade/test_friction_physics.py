@@ -246,32 +246,33 @@ def internal(tmp_path_factory, name, overrides, stresses):
 
 def test_internal_friction_fresh_fill_per_step_repeats_bit_for_bit(tmp_path_factory):
     """fill_each_step: fresh - the same seed gives the same fill, so two steps at the same
-    stress are the same simulation."""
+    stress are the same simulation (the shipped cell, free to tip)."""
     r = internal(tmp_path_factory, "internal_start", {}, [3000, 3000])
     assert r["fill_each_step"] == "fresh"
     assert_documented(r)
     assert r["mu_static"][0] == r["mu_static"][1]
     assert r["onset_angle_deg"][0] == r["onset_angle_deg"][1]
-    assert r["cell_rotation_onset_deg"] == [0.0, 0.0]       # a guided cell does not turn
+    assert r["cell_rotation_onset_deg"][0] == r["cell_rotation_onset_deg"][1]
 
 
 def test_a_cell_free_to_turn_records_how_far_it_turned(tmp_path_factory):
-    """sliding_cell_rotations: free (the internal-cell audit): the mobile cell tips as it
-    is pushed over the contents, and the rig says by how much at the onset (the guided
-    cell above reads exactly 0)."""
-    r = internal(tmp_path_factory, "internal_turning", {"rig.procedure.sliding_cell_rotations": "free"}, [3000])
-    assert r["onset_angle_deg"][0] is not None
-    assert 0.01 < r["cell_rotation_onset_deg"][0] < 45.0
+    """sliding_cell_rotations: free (the shipped rig): the mobile cell tips as it is pushed
+    over the contents, and the rig says by how much at the onset; a guided cell
+    (blocked) on the same fill reads exactly 0."""
+    free = internal(tmp_path_factory, "internal_start", {}, [3000, 3000])
+    guided = internal(tmp_path_factory, "internal_guided", {"rig.procedure.sliding_cell_rotations": "blocked"}, [3000])
+    assert free["onset_angle_deg"][0] is not None
+    assert 0.01 < free["cell_rotation_onset_deg"][0] < 45.0
+    assert guided["cell_rotation_onset_deg"] == [0.0]
 
 
 def test_a_tipping_cell_moves_its_centre_of_mass_before_its_rim(tmp_path_factory):
-    """slide_read_at: shear_plane reads a turning cell's slide at the centre of its bottom
-    rim: a cell that tips forward carries its centre of mass (~70 mm up) ahead of the rim on
-    the shear plane, so the same fill (same seed) reaches 1 mm of slide later there, after
-    turning further (M3-dry, 5 seeds at friction 0.5: 1.7 - 2.9 deg against 0.5)."""
-    com = internal(tmp_path_factory, "internal_turning", {"rig.procedure.sliding_cell_rotations": "free"}, [3000])
-    rim = internal(tmp_path_factory, "internal_turning_rim", {"rig.procedure.sliding_cell_rotations": "free",
-                                                             "rig.procedure.slide_read_at": "shear_plane"}, [3000])
+    """slide_read_at: shear_plane (shipped) reads a turning cell's slide at the centre of its
+    bottom rim: a cell that tips forward carries its centre of mass (~70 mm up) ahead of the
+    rim on the shear plane, so the same fill (same seed) reaches 1 mm of slide later there,
+    after turning further (M3-dry, 5 seeds at friction 0.5: 1.7 - 2.9 deg against 0.5)."""
+    com = internal(tmp_path_factory, "internal_turning_com", {"rig.procedure.slide_read_at": "body"}, [3000])
+    rim = internal(tmp_path_factory, "internal_start", {}, [3000, 3000])
     assert rim["onset_angle_deg"][0] > com["onset_angle_deg"][0]
     assert rim["cell_rotation_onset_deg"][0] > com["cell_rotation_onset_deg"][0]
 
