@@ -1,0 +1,21 @@
+"""bench/seeds_per_point_toy.py: the toy stages land on their known roots, and two seeds per
+point need fewer runs than three on the wall stage's line (the study's seeds_count)."""
+import numpy as np
+
+from bench_scripts import load_bench_script
+
+
+def test_two_seeds_per_point_reach_the_wall_root_with_fewer_runs():
+    toy = load_bench_script("seeds_per_point_toy")
+    case = toy.CASES_1D["wall"]
+    three = [toy.run_1d(case, 3, np.random.default_rng(d)) for d in range(6)]
+    two = [toy.run_1d(case, 2, np.random.default_rng(d)) for d in range(6)]
+    assert all(abs(r[0] - 0.514) < 0.05 for r in three + two)        # within the tolerance of the root
+    assert np.mean([r[4] for r in two]) < np.mean([r[4] for r in three]) - 1.5
+
+
+def test_the_table_row_counts_met_and_held_draws():
+    toy = load_bench_script("seeds_per_point_toy")
+    rows = [(0.51, 0.50, 0.52, "interval within tolerance", 9), (0.60, 0.55, 0.65, "run budget spent", 18)]
+    row = toy.summarise("wall", 2, rows, 0.514)
+    assert row.startswith("| wall | 2 | 13.5 | 1 of 2 | 1 of 2 |")
