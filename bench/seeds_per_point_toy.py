@@ -18,6 +18,9 @@ Cases (responses as the main jobs measured them):
   tolerance 0.05, budget 36 (the rolling stages);
 - cohesion: a cell that starts to hang on: 90 / (1 + exp(-(x - 0.1) / 0.02)) - 30 deg against
   the pull-off pressure fraction, target 0, seed SD 8 deg, tolerance 0.02, budget 18;
+- wall_bent, wall_bent_slope06: the wall cell as two main jobs measured it (b7c959b, seed bases 1 and
+  101): mu_bulk - lab = 0.6 (x - 0.555) up to x = 0.65, slope 0.35 above, seed SD 0.03; the Newton
+  second point assumes the config's slope 1.0, or the measured 0.6 (2 seeds per point in both rows);
 - wet_wall: the joint stage over fines-steel friction f and adhesion p: mu(s) = f + 3e-4 p s at
   12 / 40 / 90 kPa, lab 0.40 + 3.5e-6 s (truth f 0.40, p 0.01167), seed SD 0.01, tolerances
   0.05 / 0.004, budget 36, start (0.5, 0.005) and a tenth of the bounds per parameter.
@@ -42,6 +45,16 @@ CASES_1D = {   # name: response, scale, start, target, seed SD, tolerance, budge
     "cohesion": (lambda x: 90 / (1 + np.exp(-(x - 0.1) / 0.02)) - 30, Scale(0.0, 0.5), 0.1, 0.0, 8.0, 0.02, 18,
                  0.1 + 0.02 * math.log(30 / 60), None),
 }
+
+
+def _wall_bent(x):
+    """The measured wall-cell response (mu offset) against particle-steel friction x."""
+    x = np.asarray(x, dtype=float)
+    return np.where(x < 0.65, 0.6 * (x - 0.555), 0.6 * 0.095 + 0.35 * (x - 0.65))
+
+
+CASES_1D["wall_bent"] = (_wall_bent, Scale(0.05, 1.2), 0.5, 0.0, 0.03, 0.05, 18, 0.555, 1.0)
+CASES_1D["wall_bent_slope06"] = (_wall_bent, Scale(0.05, 1.2), 0.5, 0.0, 0.03, 0.05, 18, 0.555, 0.6)
 STRESSES_PA = np.array([12000.0, 40000.0, 90000.0])
 WET_TRUTH = (0.40, 3.5e-6 / 3e-4)
 
@@ -113,11 +126,12 @@ def main(argv=None):
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--draws", type=int, default=20)
     ap.add_argument("--cases", default="wall,wall_noisy,aor,cohesion,wet_wall")
+    ap.add_argument("--seeds", default="3,2", help="seeds per point to compare (default 3,2)")
     args = ap.parse_args(argv)
     print("| case | seeds per point | runs to the stop, mean | met | interval holds the truth | RMS error | largest error |")
     print("|---|---|---|---|---|---|---|")
     for name in args.cases.split(","):
-        for seeds in (3, 2):
+        for seeds in (int(v) for v in args.seeds.split(",")):
             if name == "wet_wall":
                 res = [run_wet_wall(seeds, np.random.default_rng(d)) for d in range(args.draws)]
                 truth = WET_TRUTH
