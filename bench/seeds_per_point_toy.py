@@ -37,6 +37,14 @@ from pycal.stats import stopping  # noqa: E402
 from pycal.stats.scales import Scale, round_significant  # noqa: E402
 from pycal.stats.sequential import second_point_u, step_1d, step_nd  # noqa: E402
 
+
+def _wall_bent(x):
+    """The measured wall-cell response (mu offset) against particle-steel friction x: slope 0.6
+    through the root 0.555 up to the knee 0.65, 0.35 above."""
+    x = np.asarray(x, dtype=float)
+    return np.where(x < 0.65, 0.6 * (x - 0.555), 0.6 * (0.65 - 0.555) + 0.35 * (x - 0.65))
+
+
 CASES_1D = {   # name: response, scale, start, target, seed SD, tolerance, budget, truth, slope (per unit of x) or None
     "wall": (lambda x: x - 0.514, Scale(0.05, 1.2), 0.5, 0.0, 0.02, 0.05, 18, 0.514, 1.0),
     "wall_noisy": (lambda x: x - 0.514, Scale(0.05, 1.2), 0.5, 0.0, 0.04, 0.05, 18, 0.514, 1.0),
@@ -44,17 +52,9 @@ CASES_1D = {   # name: response, scale, start, target, seed SD, tolerance, budge
             -math.log(10 / 28) / 2.5, None),
     "cohesion": (lambda x: 90 / (1 + np.exp(-(x - 0.1) / 0.02)) - 30, Scale(0.0, 0.5), 0.1, 0.0, 8.0, 0.02, 18,
                  0.1 + 0.02 * math.log(30 / 60), None),
+    "wall_bent": (_wall_bent, Scale(0.05, 1.2), 0.5, 0.0, 0.03, 0.05, 18, 0.555, 1.0),
+    "wall_bent_slope06": (_wall_bent, Scale(0.05, 1.2), 0.5, 0.0, 0.03, 0.05, 18, 0.555, 0.6),
 }
-
-
-def _wall_bent(x):
-    """The measured wall-cell response (mu offset) against particle-steel friction x."""
-    x = np.asarray(x, dtype=float)
-    return np.where(x < 0.65, 0.6 * (x - 0.555), 0.6 * 0.095 + 0.35 * (x - 0.65))
-
-
-CASES_1D["wall_bent"] = (_wall_bent, Scale(0.05, 1.2), 0.5, 0.0, 0.03, 0.05, 18, 0.555, 1.0)
-CASES_1D["wall_bent_slope06"] = (_wall_bent, Scale(0.05, 1.2), 0.5, 0.0, 0.03, 0.05, 18, 0.555, 0.6)
 STRESSES_PA = np.array([12000.0, 40000.0, 90000.0])
 WET_TRUTH = (0.40, 3.5e-6 / 3e-4)
 
