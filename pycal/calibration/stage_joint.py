@@ -17,6 +17,7 @@ is tried the other way once. A refused start point (e.g. the final pass starts w
 pile is too flat for an angle, after a friction stage lowered the friction) does not end
 the stage: its first steps go on, and the stage fails only when none of them runs.
 """
+import json
 import math
 
 import numpy as np
@@ -30,6 +31,16 @@ from . import plots
 from .names import unit_label
 
 FIRST_STEP_U = 0.1      # a tenth of the bounds: a second pass starts from values already close
+
+
+def shared_runs(responses, extras):
+    """Groups of response indices read from the same runs: responses on one rig with the
+    same overrides (e.g. aor_mean_deg and surcharge_mean_deg, the pile before and after
+    the vibration of one surcharge run), in the order of their first member."""
+    groups = {}
+    for j, (r, e) in enumerate(zip(responses, extras)):
+        groups.setdefault((r["rig"], json.dumps(e, sort_keys=True)), []).append(j)
+    return list(groups.values())
 
 
 def run(study, material, st):
@@ -64,18 +75,25 @@ def run(study, material, st):
         if not replay:
             jr.record(xs)
         try:
-            cols = []
-            for j, (r, response) in enumerate(zip(st["responses"], resp)):
-                vals = study.run_point(material, label, r["rig"], extra(xs, r), response, lab_dir)
-                vals = [v if isinstance(v, list) else [v] for v in vals]
-                widths[j] = widths[j] or len(vals[0])
-                cols.append([[math.nan if v is None else float(v) for v in row] for row in vals])
+            cols = [None] * len(resp)
+            for group in shared_runs(st["responses"], [extra(xs, r) for r in st["responses"]]):
+                r0 = st["responses"][group[0]]
+                if len(group) == 1:                       # a seed without a value is left out
+                    vals_of = [study.run_point(material, label, r0["rig"], extra(xs, r0), resp[group[0]], lab_dir)]
+                else:                                     # a seed without one value keeps the others (NaN there)
+                    vals_of = study.run_point_responses(material, label, r0["rig"], extra(xs, r0),
+                                                        [resp[j] for j in group], lab_dir)
+                for j, vals in zip(group, vals_of):
+                    vals = [v if isinstance(v, list) else [v] for v in vals]
+                    widths[j] = widths[j] or len(vals[0])
+                    cols[j] = [[math.nan if v is None else float(v) for v in row] for row in vals]
         except RunError as exc:
             refused.append((xs, str(exc)))
             study.log(f"  the rig refused {xs}: no point near it is asked again")
             return False
-        # a seed without a value (e.g. a pile too flat for an angle, left out by run_point)
-        # is a NaN row of that response: each output's model uses its own finite rows
+        # a seed without a value (e.g. a pile too flat for an angle, left out by run_point, or
+        # NaN beside a value of the same run) is a NaN row of that response: each output's
+        # model uses its own finite rows
         rows = max(len(c) for c in cols)
         for i in range(rows):
             X.append(xs)

@@ -138,50 +138,64 @@ class Study:
                        "batch_job_id": ((r or {}).get("provenance") or {}).get("batch_job_id", "")}
                       for j, r in zip(jobs, results)]
 
-    def _drop_missing(self, values, results, rig, response, extra):
-        """Leave out the seeds whose scalar response has no value (NaN: e.g. a pile too flat
-        for any sector to have an angle), with a warning; when more than one in three
-        seeds has none, the point cannot be measured: RunError (a one-parameter stage
+    def _missing_seeds(self, values, rig, response, extra):
+        """The seeds (of self.last_seeds) whose scalar response has no value (NaN: e.g. a pile
+        too flat for any sector to have an angle), with a warning; when more than one in
+        three seeds has none, the point cannot be measured: RunError (a one-parameter stage
         then backs off from it, as from a point the rig refuses)."""
         missing = [s for s, v in zip(self.last_seeds, values)
                    if not isinstance(v, list) and (v is None or math.isnan(v))]
         if not missing:
-            return values, results
+            return []
         where = format_params({k: v for k, v in extra.items() if not k.startswith("rig.")})
         if len(missing) > max(1, len(values) // 3):
             raise RunError(f"{rig}: {response.name} has no value on seeds {missing} of {list(self.last_seeds)} "
                            f"at {where} (the rig ran, the response could not be read: e.g. a pile too flat "
                            f"for an angle)")
         self.log(f"  WARNING: {rig}: {response.name} has no value on seed(s) {missing} at {where}; left out")
-        keep = [i for i, s in enumerate(self.last_seeds) if s not in missing]
-        self.last_seeds = [self.last_seeds[i] for i in keep]
-        return [values[i] for i in keep], [results[i] for i in keep]
+        return missing
 
     def run_point(self, material, stage, rig, extra, response, lab_dir, count=None):
         """Values of `response` (pycal.post.responses) at one parameter point: `count` runs
         (default seeds_count) with the material's current overrides + `extra`. Every point
         (and a point run again) gets its stage's next unused seeds on this rig: the stage's
-        runs are independent draws of the random fill."""
+        runs are independent draws of the random fill. A seed without a value is left out
+        (self.last_seeds: the seeds behind the values returned)."""
+        values = self.run_point_responses(material, stage, rig, extra, [response], lab_dir, count)[0]
+        keep = [i for i, v in enumerate(values) if isinstance(v, list) or not math.isnan(v)]
+        self.last_seeds = [self.last_seeds[i] for i in keep]
+        return [values[i] for i in keep]
+
+    def run_point_responses(self, material, stage, rig, extra, responses, lab_dir, count=None):
+        """Values of several responses read from the same runs of one point (e.g. the pile's
+        angle before and after the vibration, both from one surcharge run): one list per
+        response, in the order of self.last_seeds, NaN where a seed has no value for that
+        response (RunError when more than one seed in three has none for any response)."""
         key = (material, stage, rig, json.dumps(extra, sort_keys=True))
         used = self._stage_seeds.setdefault((material, stage, rig), [])
         count = count or len(self.seeds)
         seeds = self.seeds[:count] if not used else list(range(max(used) + 1, max(used) + 1 + count))
         results = self._run_seeds(rig, material, {**self.overrides[material], **extra}, seeds)
         used += self.last_seeds
-        values = [response.value(r, lab_dir) for r in results]
-        values, results = self._drop_missing(values, results, rig, response, extra)
-        self.point_results.setdefault(key, []).extend(results)
+        values = [[math.nan if v is None else v for v in (response.value(r, lab_dir) for r in results)]
+                  for response in responses]
+        missing = [self._missing_seeds(vals, rig, response, extra) for response, vals in zip(responses, values)]
+        # the runs behind the point (its pictures and lab-curve plots): those with a value to show
+        self.point_results.setdefault(key, []).extend(
+            r for seed, r in zip(self.last_seeds, results) if any(seed not in m for m in missing))
         params = {k: v for k, v in extra.items() if not k.startswith("rig.")}
-        for seed, v in zip(self.last_seeds, values):
-            self.runs.append({"material": material, "stage": stage, "rig": rig, "parameters": params,
-                              "seed": seed, "response": response.name, "value": v})
-        scalar = [v for v in values if not isinstance(v, list)]
-        m, s = mean_std(scalar) if scalar else (math.nan, math.nan)
-        self.points.append({"material": material, "stage": stage, "rig": rig, "parameters": params,
-                            "response": response.name, "mean": m, "std": s, "n": len(values),
-                            "seeds": list(self.last_seeds)})
-        shown = f"{m:.4g} +/- {s:.2g}" if scalar else f"{len(values)} vectors"
-        self.log(f"  {format_params(params)} -> {response.name} {shown} (n {len(values)}; {self.progress_text()})")
+        for response, vals, miss in zip(responses, values, missing):
+            kept = [(seed, v) for seed, v in zip(self.last_seeds, vals) if seed not in miss]
+            for seed, v in kept:
+                self.runs.append({"material": material, "stage": stage, "rig": rig, "parameters": params,
+                                  "seed": seed, "response": response.name, "value": v})
+            scalar = [v for _, v in kept if not isinstance(v, list)]
+            m, s = mean_std(scalar) if scalar else (math.nan, math.nan)
+            self.points.append({"material": material, "stage": stage, "rig": rig, "parameters": params,
+                                "response": response.name, "mean": m, "std": s, "n": len(kept),
+                                "seeds": [seed for seed, _ in kept]})
+            shown = f"{m:.4g} +/- {s:.2g}" if scalar else f"{len(kept)} vectors"
+            self.log(f"  {format_params(params)} -> {response.name} {shown} (n {len(kept)}; {self.progress_text()})")
         return values
 
     def progress_text(self):

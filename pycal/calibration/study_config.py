@@ -42,6 +42,8 @@ KINDS = ONE_D + ("joint", "inherit")
 LOG_SCALE_KINDS = ("density", "stiffness")
 DENSITY_KEY = "particles.density_kg_m3"
 DEFAULT_POINTS_COUNT = 8          # a stage's default run budget: this many points' worth of runs
+LAB_ANGLE_TESTS = {"aor_mean_deg": "angle_of_repose",   # response -> the lab table its angle comes from
+                   "surcharge_mean_deg": "surcharge"}
 
 REMOVED = {
     "max_iterations_count": "replaced by max_runs_count (a run budget: every seed counts)",
@@ -148,8 +150,12 @@ def _target(c, t, key, response):
     elif not has_lab and response.name != "bulk_density_kg_m3":
         c.fail(key, f"needs value (or sample + test for an angle); only bulk_density_kg_m3 defaults to the "
                     f"material's lab sample")
-    if has_lab and response.name not in ("aor_mean_deg",):
-        c.fail(f"{key}.sample", f"a lab sample's angle is a target of aor_mean_deg only, not {response.name}")
+    if has_lab and response.name not in LAB_ANGLE_TESTS:
+        c.fail(f"{key}.sample", f"a lab sample's angle is a target of {' or '.join(LAB_ANGLE_TESTS)} only, "
+                                f"not {response.name}")
+    if has_lab and t["test"] != LAB_ANGLE_TESTS[response.name]:
+        c.fail(f"{key}.test", f"{response.name} reads the lab's {LAB_ANGLE_TESTS[response.name]} angle, "
+                              f"not {t['test']!r}")
     for k in (f"band_{unit}", "band_percent", f"standard_error_{unit}"):
         if k in t:
             c.number(t[k], f"{key}.{k}", 0)

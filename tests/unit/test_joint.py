@@ -1,5 +1,6 @@
 """Joint stages: 2-3 coupled parameters, a posterior over them (GP surrogate + emcee), on
 fake rigs with known answers."""
+import json
 import math
 
 import pytest
@@ -169,3 +170,50 @@ def test_bad_joint_stage_names_the_field(tmp_path, old, new, message):
     with pytest.raises(ConfigError, match=message) as exc:
         load_study(p)
     assert "bad.yaml" in str(exc.value)
+
+
+SURCHARGE_JOINT = """
+name: surcharge_joint
+seeds_count: 2
+materials:
+  M3-dry:
+    - stage: joint
+      name: friction_rolling
+      responses:
+        - {rig: surcharge, response: aor_mean_deg, target: {sample: fines_dry, test: angle_of_repose, band_deg: 2.0}}
+        - {rig: surcharge, response: surcharge_mean_deg, target: {sample: fines_dry, test: surcharge, band_deg: 2.0}}
+      parameters:
+        - {keys: [interactions.M3-dry.friction_coefficient], start: 0.5, bounds: [0.05, 1.2], tolerance_coefficient: 0.05}
+        - keys: [interactions.M3-dry.rolling_resistance_coefficient]
+          start: 0.3
+          bounds: [0.02, 1.5]
+          tolerance_coefficient: 0.05
+      max_runs_count: 80
+"""
+
+
+def test_two_responses_of_one_rig_are_read_from_the_same_runs(tmp_path):
+    """The pile before and after the vibration come from one surcharge run: a joint stage over
+    particle friction mu and rolling resistance eta reads both from the same runs (one job per
+    seed and point, not two). Fake laws: AoR = 20 + 30 eta + 10 mu, surcharge = 10 eta + 40 mu
+    (deg); the lab's fines_dry (38 / 28 deg) is met at mu = 0.6, eta = 0.4."""
+    def surcharge(j):
+        pair = j["materials"]["M3-dry"]["interactions"]["M3-dry"]
+        mu, eta = pair["friction_coefficient"], pair["rolling_resistance_coefficient"]
+        return {"aor_mean_deg": 20 + 30 * eta + 10 * mu, "surcharge_mean_deg": 10 * eta + 40 * mu}
+    cfg = tmp_path / "s.yaml"
+    cfg.write_text(SURCHARGE_JOINT)
+    ex = FakeRigs(results={"surcharge": surcharge}, noise={"surcharge_mean_deg": 0.5})
+    study = Study(cfg, ex, tmp_path / "out", log=quiet)
+    (row,) = study.run()
+    mu, eta = row["parameters"]
+    assert labdata.aor_target_deg("fines_dry") == 38.0 and labdata.aor_target_deg("fines_dry", "surcharge") == 28.0
+    assert holds(mu, 0.6) and holds(eta, 0.4)
+    # one job per seed and point: the two responses share them
+    assert len({j["job_id"] for j in ex.asked}) == len(ex.asked) == row["runs_requested"]
+    per_response = {r["response"]: [(json.dumps(r["parameters"], sort_keys=True), r["seed"]) for r in study.runs]
+                    for r in study.runs}
+    assert set(per_response) == {"aor_mean_deg", "surcharge_mean_deg"}
+    rows = {name: [(json.dumps(r["parameters"], sort_keys=True), r["seed"]) for r in study.runs if r["response"] == name]
+            for name in per_response}
+    assert rows["aor_mean_deg"] == rows["surcharge_mean_deg"]
