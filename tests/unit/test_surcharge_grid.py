@@ -1,0 +1,54 @@
+"""bench/surcharge_grid.py: its runs found again from their overrides, and the table's means."""
+import json
+
+from bench_scripts import load_bench_script
+
+grid = load_bench_script("surcharge_grid")
+
+
+def fake_run(folder, friction, rolling, seed, aor, surcharge, heights=(0.08, 0.05), material="M3-dry", lift=0.01,
+             scale=1.0):
+    ov = {**grid.settings(material, friction, rolling, scale), "rig.procedure.lift_speed_m_s": lift,
+          "particles.density_kg_m3": 3459.0}
+    m = {"aor_mean_deg": aor, "surcharge_mean_deg": surcharge, "pile_height_m": heights[0],
+         "surcharge_pile_height_m": heights[1]}
+    r = {"material": material, "seeds": [seed], "job": {"overrides": ov},
+         "replicas": [{"seed": seed, "status": "ok", "measurements": m}],
+         "provenance": {"cpu_time_s": 20.0 + seed}}
+    d = folder / "surcharge" / f"job-{friction}-{rolling}-{seed}-{lift}-{scale}"
+    d.mkdir(parents=True)
+    (d / "result.json").write_text(json.dumps(r))
+
+
+def test_grid_points_are_found_from_their_overrides_and_tabulated(tmp_path):
+    fake_run(tmp_path, 0.5, 0.15, 1, 40.0, 20.0)
+    fake_run(tmp_path, 0.5, 0.15, 2, 36.0, None)           # flattened: no angle after the vibration
+    fake_run(tmp_path, 0.8, 0.05, 1, 45.0, 30.0)
+    fake_run(tmp_path, 0.8, 0.05, 2, 44.0, 28.0, lift=0.002)   # another lift speed: not a grid run
+    fake_run(tmp_path, 0.8, 0.05, 3, 30.0, 10.0, material="M2")
+    fake_run(tmp_path, 0.8, 0.05, 4, 44.0, 35.0, scale=0.25)   # a gentler vibration: its own grid point
+    two = {"material": "M3-dry", "seeds": [5, 6], "job": {"overrides": grid.settings("M3-dry", 0.3, 0.4)},
+           "replicas": [{"seed": 5, "status": "ok", "measurements": {"aor_mean_deg": 30.0, "pile_height_m": 0.07,
+                                                                      "surcharge_pile_height_m": 0.03}},
+                        {"seed": 6, "status": "failed", "measurements": {}}],
+           "provenance": {"cpu_time_s": 50.0}}                      # two seeds in one job, one failed
+    (tmp_path / "surcharge" / "two").mkdir()
+    (tmp_path / "surcharge" / "two" / "result.json").write_text(json.dumps(two))
+    groups = grid.load(tmp_path, "M3-dry")
+    assert sorted(groups) == [(0.3, 0.4, 1.0), (0.5, 0.15, 1.0), (0.8, 0.05, 0.25), (0.8, 0.05, 1.0)]
+    assert [(r["seed"], r["cpu_time_s"]) for r in groups[(0.3, 0.4, 1.0)]] == [(5, 25.0)]   # the job's CPU over 2 seeds
+    assert len(groups[(0.5, 0.15, 1.0)]) == 2 and len(groups[(0.8, 0.05, 1.0)]) == 1
+    text = grid.table(groups)
+    row = next(line for line in text.splitlines() if line.startswith("| 0.5 | 0.15 |"))
+    cells = [c.strip() for c in row.strip("|").split("|")]
+    assert cells[4] == "38.0 (2.8)"          # AoR mean (SD) over both seeds
+    assert cells[5] == "20.0"                # surcharge: the one seed with an angle, no SD
+    assert cells[6] == "1 of 2"
+    assert cells[7] == "80 / 50"             # pile height before / after, mm
+    assert cells[8] == "22"                  # median CPU of 21 and 22 s
+
+
+def test_peak_acceleration_of_a_sinusoid():
+    # 25 Hz at 0.5 mm: (2 pi 25)^2 0.0005 = 12.34 m/s2 = 1.258 g
+    assert abs(grid.peak_acceleration_g(25.0, 0.0005) - 12.337 / 9.81) < 1e-3
+    assert abs(grid.peak_acceleration_g(1.0 / (2 * 3.141592653589793), 9.81) - 1.0) < 1e-12
