@@ -7,17 +7,24 @@ grid = load_bench_script("surcharge_grid")
 
 
 def fake_run(folder, friction, rolling, seed, aor, surcharge, heights=(0.08, 0.05), material="M3-dry", lift=0.01,
-             scale=1.0):
-    ov = {**grid.settings(material, friction, rolling, scale), "rig.procedure.lift_speed_m_s": lift,
+             amplitude_mm=0.125):
+    ov = {**grid.settings(material, friction, rolling), "rig.procedure.lift_speed_m_s": lift,
           "particles.density_kg_m3": 3459.0}
-    m = {"aor_mean_deg": aor, "surcharge_mean_deg": surcharge, "pile_height_m": heights[0],
+    m = {"aor_mean_deg": aor, "surcharge_mean_deg": surcharge, "surcharge_left_deg": surcharge,
+         "surcharge_right_deg": None, "pile_height_m": heights[0],
          "surcharge_pile_height_m": heights[1]}
-    r = {"material": material, "seeds": [seed], "job": {"overrides": ov},
+    r = {"material": material, "seeds": [seed], "job": {"overrides": ov, "rig_config": rig(amplitude_mm)},
          "replicas": [{"seed": seed, "status": "ok", "measurements": m}],
          "provenance": {"cpu_time_s": 20.0 + seed}}
-    d = folder / "surcharge" / f"job-{friction}-{rolling}-{seed}-{lift}-{scale}"
+    d = folder / "surcharge" / f"job-{friction}-{rolling}-{seed}-{lift}-{amplitude_mm}"
     d.mkdir(parents=True)
     (d / "result.json").write_text(json.dumps(r))
+
+
+def rig(amplitude_mm):
+    """The resolved rig config's procedure as a job records it."""
+    return {"procedure": {"vibration_frequency_hz": 25.0, "vibration_amplitude_horizontal_m": amplitude_mm * 1e-3,
+                          "vibration_amplitude_vertical_m": amplitude_mm * 0.6e-3}}
 
 
 def test_grid_points_are_found_from_their_overrides_and_tabulated(tmp_path):
@@ -26,8 +33,9 @@ def test_grid_points_are_found_from_their_overrides_and_tabulated(tmp_path):
     fake_run(tmp_path, 0.8, 0.05, 1, 45.0, 30.0)
     fake_run(tmp_path, 0.8, 0.05, 2, 44.0, 28.0, lift=0.002)   # another lift speed: not a grid run
     fake_run(tmp_path, 0.8, 0.05, 3, 30.0, 10.0, material="M2")
-    fake_run(tmp_path, 0.8, 0.05, 4, 44.0, 35.0, scale=0.25)   # a gentler vibration: its own grid point
-    two = {"material": "M3-dry", "seeds": [5, 6], "job": {"overrides": grid.settings("M3-dry", 0.3, 0.4)},
+    fake_run(tmp_path, 0.8, 0.05, 4, 44.0, 35.0, amplitude_mm=0.5)   # another vibration: its own grid point
+    two = {"material": "M3-dry", "seeds": [5, 6],
+           "job": {"overrides": grid.settings("M3-dry", 0.3, 0.4), "rig_config": rig(0.125)},
            "replicas": [{"seed": 5, "status": "ok", "measurements": {"aor_mean_deg": 30.0, "pile_height_m": 0.07,
                                                                       "surcharge_pile_height_m": 0.03}},
                         {"seed": 6, "status": "failed", "measurements": {}}],
@@ -35,17 +43,20 @@ def test_grid_points_are_found_from_their_overrides_and_tabulated(tmp_path):
     (tmp_path / "surcharge" / "two").mkdir()
     (tmp_path / "surcharge" / "two" / "result.json").write_text(json.dumps(two))
     groups = grid.load(tmp_path, "M3-dry")
-    assert sorted(groups) == [(0.3, 0.4, 1.0), (0.5, 0.15, 1.0), (0.8, 0.05, 0.25), (0.8, 0.05, 1.0)]
-    assert [(r["seed"], r["cpu_time_s"]) for r in groups[(0.3, 0.4, 1.0)]] == [(5, 25.0)]   # the job's CPU over 2 seeds
-    assert len(groups[(0.5, 0.15, 1.0)]) == 2 and len(groups[(0.8, 0.05, 1.0)]) == 1
+    v1, v4 = (25.0, 0.000125, 0.000075), (25.0, 0.0005, 0.0003)
+    assert sorted(groups) == [(0.3, 0.4, v1), (0.5, 0.15, v1), (0.8, 0.05, v1), (0.8, 0.05, v4)]
+    assert [(r["seed"], r["cpu_time_s"]) for r in groups[(0.3, 0.4, v1)]] == [(5, 25.0)]   # the job's CPU over 2 seeds
+    assert len(groups[(0.5, 0.15, v1)]) == 2 and len(groups[(0.8, 0.05, v1)]) == 1
     text = grid.table(groups)
     row = next(line for line in text.splitlines() if line.startswith("| 0.5 | 0.15 |"))
+    assert "| 0.125 / 0.075 (0.31 / 0.19) at 25 Hz |" in row
     cells = [c.strip() for c in row.strip("|").split("|")]
     assert cells[4] == "38.0 (2.8)"          # AoR mean (SD) over both seeds
     assert cells[5] == "20.0"                # surcharge: the one seed with an angle, no SD
     assert cells[6] == "1 of 2"
-    assert cells[7] == "80 / 50"             # pile height before / after, mm
-    assert cells[8] == "22"                  # median CPU of 21 and 22 s
+    assert cells[7] == "20.0; 1 / -; 0"      # left: one seed's angle; right: none
+    assert cells[8] == "80 / 50"             # pile height before / after, mm
+    assert cells[9] == "22"                  # median CPU of 21 and 22 s
 
 
 def test_peak_acceleration_of_a_sinusoid():
