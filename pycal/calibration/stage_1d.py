@@ -182,7 +182,8 @@ def run(study, material, st):
             step.stop = stopping.STUDY_BUDGET
             break
     step.estimate = round_significant(step.estimate)
-    jr.finish({k: getattr(step, k) for k in ("estimate", "low", "high", "tolerance", "band_low", "band_high", "stop")})
+    jr.finish({k: getattr(step, k) for k in ("estimate", "low", "high", "tolerance", "band_low", "band_high", "stop",
+                                              "next_x")})
     return _row(study, material, st, p, scale, xs, ys, step, target, response, refused, lo_u, hi_u, extra, lab_dir)
 
 
@@ -218,7 +219,9 @@ def _message(step, p, scale, xs, ys, target, refused, lo_u, hi_u):
         near = [y for x, y in zip(xs, ys) if abs(float(scale.to_unit(x)) - float(scale.to_unit(at))) < 0.01]
         msg = (f"the target {target.value:.4g} lies beyond what {p['label']} = {at:.4g} reaches "
                f"({np.mean(near):.4g} there, {len(near)} runs)")
-    if step.stop == stopping.REPEATS:
+    if step.stop == stopping.REPEATS and step.next_x is None:     # a journal written before next_x was kept
+        msg += "; stopped: the next point had run at length already"
+    elif step.stop == stopping.REPEATS:
         x = round_significant(step.next_x)
         msg += f"; stopped: the next point, {x:.4g}, had run {xs.count(x)} times already"
     if refused:

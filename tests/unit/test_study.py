@@ -787,3 +787,24 @@ def test_the_console_shows_stage_runs_and_time_left(tmp_path, study_file):
     points = [line for line in log if " -> aor_mean_deg " in line]
     assert points and all(" runs; left <= " in line for line in points)
     assert all(len(line) <= 125 for line in points), max(points, key=len)
+
+
+def test_a_resumed_stage_that_stopped_on_a_repeated_point_says_which(tmp_path, study_file):
+    """A 1-D stage that stopped because its next point had run at length (stopping.REPEATS)
+    resumes from its journal with the same message; a journal written before the next point
+    was kept resumes too (it crashed on the missing point: seed base 101's dry rolling stage)."""
+    cache = {}
+    Study(study_file, FakeRigs(cache=cache), tmp_path / "out", log=quiet).run()
+    path = tmp_path / "out" / "twin" / "journal.json"
+    journal = json.loads(path.read_text())
+    key = next(k for k in journal if "rolling_resistance" in k and "M3-dry" in k)
+    x = journal[key]["points"][-1]
+    journal[key]["result"].update(stop=stopping.REPEATS, next_x=x)
+    path.write_text(json.dumps(journal))
+    rows = by_stage(Study(study_file, FakeRigs(cache=cache), tmp_path / "out", log=quiet).run())
+    msg = rows[("M3-dry", "rolling_resistance")]["message"]
+    assert f"stopped: the next point, {x:.4g}, had run" in msg
+    del journal[key]["result"]["next_x"]
+    path.write_text(json.dumps(journal))
+    rows = by_stage(Study(study_file, FakeRigs(cache=cache), tmp_path / "out", log=quiet).run())
+    assert "stopped: the next point had run at length already" in rows[("M3-dry", "rolling_resistance")]["message"]
