@@ -2,7 +2,7 @@
 
     /usr/bin/python3 bench/surcharge_grid.py RUNS_DIR --calibrated STUDY_DIR [--material M3-dry] \
         [--frictions 0.3,0.5,0.8] [--rolling 0.05,0.15,0.4] [--seeds 4] [--workers 2] \
-        [--amplitudes-mm 0.125,0.5] [--table-only] [--out table.md]
+        [--amplitudes-mm 0.125,0.5] [--table-only] [--readings] [--out table.md]
 
 Runs `pycal run surcharge` (cached: a stopped grid resumes) with a study's calibrated values
 of the material (--calibrated: its output folder, e.g. runs/study/zinc_ore) and the lift speed
@@ -15,7 +15,9 @@ rig's own. Each run's amplitudes are read back from its job's resolved rig confi
 One surcharge run gives both angles: the static pile before the vibration (aor_mean_deg, the
 AoR stage's response) and after it (surcharge_mean_deg). Prints per grid point the mean and SD
 over the seeds of both, how many seeds have an angle after the vibration, the pile height
-before and after (m), and the median CPU per run.
+before and after (m), and the median CPU per run. --readings adds a second table: the other candidate
+readings of pycal.post.aor_readings (sector median, sector fit over rotated frames, cone) of each seed's
+pile before and after the vibration (pile_particles.csv, surcharge_particles.csv), mean (SD; seeds).
 """
 import argparse
 import json
@@ -30,6 +32,10 @@ import yaml
 ROOT = Path(__file__).resolve().parent.parent
 sys.path.insert(0, str(ROOT))
 from pycal.files import write_text  # noqa: E402
+from pycal.post.aor import read_positions_csv  # noqa: E402
+from pycal.post.aor_readings import READINGS  # noqa: E402
+
+OTHER_READINGS = ("sector_median", "rotated_sector_mean", "cone")
 
 LIFT_SPEED_M_S = 0.01          # as the study's AoR stages and surcharge predictions
 G_M_S2 = 9.81
@@ -96,8 +102,9 @@ def load(runs, material):
         cpu = r["provenance"]["cpu_time_s"] / max(1, len(reps))
         for rep in reps:
             if rep.get("status") == "ok":
-                out.setdefault((fr, rr, vib), []).append({**rep["measurements"], "seed": rep["seed"],
-                                                            "cpu_time_s": cpu})
+                seed = {**rep["measurements"], "seed": rep["seed"], "cpu_time_s": cpu,
+                        "measure": r["job"]["rig_config"]["measure"], "folder": path.parent / rep["output_dir"]}
+                out.setdefault((fr, rr, vib), []).append(seed)
     return out
 
 
@@ -134,8 +141,33 @@ def table(groups):
         cpu = statistics.median(r["cpu_time_s"] for r in rs)
         vib = (f"{1e3 * ah:g} / {1e3 * av:g} ({peak_acceleration_g(f, ah):.2f} / {peak_acceleration_g(f, av):.2f}) "
                f"at {f:g} Hz")
-        lines.append(f"| {fr} | {rr} | {vib} | {len(rs)} | {fmt(*aor)} | {fmt(*sur)} | {with_angle} of {len(rs)} | {sides} "
-                     f"| {h0[0]:.0f} / {h1[0]:.0f} | {cpu:.0f} |")
+        lines.append(f"| {fr} | {rr} | {vib} | {len(rs)} | {fmt(*aor)} | {fmt(*sur)} | {with_angle} of {len(rs)} "
+                     f"| {sides} | {h0[0]:.0f} / {h1[0]:.0f} | {cpu:.0f} |")
+    return "\n".join(lines)
+
+
+def readings(seed):
+    """{(reading, "before" | "after"): angle deg} of one seed's pile files."""
+    out = {}
+    for when, name in (("before", "pile_particles.csv"), ("after", "surcharge_particles.csv")):
+        pos = read_positions_csv(Path(seed["folder"]) / name)
+        for reading in OTHER_READINGS:
+            out[(reading, when)] = READINGS[reading](pos, seed["measure"])
+    return out
+
+
+def readings_table(groups):
+    """Markdown rows: per grid point and reading, the angle before and after, mean (SD; seeds with a value)."""
+    lines = ["| particle friction | rolling resistance | horizontal amplitude, mm | reading | before, deg (SD; seeds) "
+             "| after, deg (SD; seeds) |", "|---|---|---|---|---|---|"]
+    for (fr, rr, (_, ah, _)), rs in sorted(groups.items()):
+        got = [readings(r) for r in rs]
+        for reading in OTHER_READINGS:
+            cells = []
+            for when in ("before", "after"):
+                vals = [g[(reading, when)] for g in got]
+                cells.append(f"{fmt(*mean_sd(vals))}; {sum(not math.isnan(v) for v in vals)}")
+            lines.append(f"| {fr} | {rr} | {1e3 * ah:g} | {reading} | {cells[0]} | {cells[1]} |")
     return "\n".join(lines)
 
 
@@ -151,17 +183,22 @@ def main(argv=None):
     ap.add_argument("--amplitudes-mm", default=None,
                     help="horizontal vibration amplitudes, mm (vertical at the rig's ratio); default the rig's own")
     ap.add_argument("--table-only", action="store_true", help="only tabulate the runs already in RUNS_DIR")
+    ap.add_argument("--readings", action="store_true", help="also the other pile readings, before and after")
     ap.add_argument("--out", default=None, help="also write the table (markdown) here")
     args = ap.parse_args(argv)
     if not args.table_only:
         if not args.calibrated:
-            raise SystemExit("--calibrated: needed to run (the study folder whose calibrated values the grid starts from)")
+            raise SystemExit("--calibrated: needed to run (the study folder whose calibrated values the grid "
+                             "starts from)")
         amplitudes = [None] if not args.amplitudes_mm else [1e-3 * float(a) for a in args.amplitudes_mm.split(",")]
         for amp in amplitudes:
             for fr in (float(f) for f in args.frictions.split(",")):
                 for rr in (float(r) for r in args.rolling.split(",")):
                     run_point(args.runs, args.calibrated, args.material, fr, rr, args.seeds, args.workers, amp)
-    text = table(load(args.runs, args.material))
+    groups = load(args.runs, args.material)
+    text = table(groups)
+    if args.readings:
+        text += "\n\n" + readings_table(groups)
     print(text)
     if args.out:
         write_text(Path(args.out), text + "\n")

@@ -1,5 +1,9 @@
 """bench/surcharge_grid.py: its runs found again from their overrides, and the table's means."""
 import json
+import math
+
+import numpy as np
+import yaml
 
 from bench_scripts import load_bench_script
 
@@ -14,17 +18,50 @@ def fake_run(folder, friction, rolling, seed, aor, surcharge, heights=(0.08, 0.0
          "surcharge_right_deg": None, "pile_height_m": heights[0],
          "surcharge_pile_height_m": heights[1]}
     r = {"material": material, "seeds": [seed], "job": {"overrides": ov, "rig_config": rig(amplitude_mm)},
-         "replicas": [{"seed": seed, "status": "ok", "measurements": m}],
+         "replicas": [{"seed": seed, "status": "ok", "measurements": m, "output_dir": f"s{seed}"}],
          "provenance": {"cpu_time_s": 20.0 + seed}}
     d = folder / "surcharge" / f"job-{friction}-{rolling}-{seed}-{lift}-{amplitude_mm}"
     d.mkdir(parents=True)
     (d / "result.json").write_text(json.dumps(r))
 
 
+MEASURE = yaml.safe_load((grid.ROOT / "configs" / "rigs" / "surcharge.yaml").read_text())["measure"]
+
+
 def rig(amplitude_mm):
-    """The resolved rig config's procedure as a job records it."""
+    """The resolved rig config's procedure and measure settings as a job records them."""
     return {"procedure": {"vibration_frequency_hz": 25.0, "vibration_amplitude_horizontal_m": amplitude_mm * 1e-3,
-                          "vibration_amplitude_vertical_m": amplitude_mm * 0.6e-3}}
+                          "vibration_amplitude_vertical_m": amplitude_mm * 0.6e-3}, "measure": MEASURE}
+
+
+def cone_pile(angle_deg, r=0.0125, height=0.11):
+    """Spheres stacked in rings so that their tops lie on a cone of flank angle angle_deg."""
+    rows = []
+    for k in range(int(height / (2 * r))):
+        z = r + 2 * r * k
+        ring = (height - (z + r)) / math.tan(math.radians(angle_deg))
+        rho = ring
+        while rho > 0:
+            count = max(1, int(2 * math.pi * rho / (2 * r)))
+            rows += [(rho * math.cos(2 * math.pi * j / count), rho * math.sin(2 * math.pi * j / count), z, r)
+                     for j in range(count)]
+            rho -= 2 * r
+        rows.append((0.0, 0.0, z, r))
+    return np.array(rows)
+
+
+def write_pile(path, a):
+    path.write_text("x_m,y_m,z_m,radius_m\n" + "".join(f"{x},{y},{z},{r}\n" for x, y, z, r in a))
+
+
+def test_the_other_readings_read_a_cone_pile_before_and_after(tmp_path):
+    folder = tmp_path / "s1"
+    folder.mkdir()
+    write_pile(folder / "pile_particles.csv", cone_pile(35.0))
+    write_pile(folder / "surcharge_particles.csv", cone_pile(20.0))
+    got = grid.readings({"folder": folder, "measure": MEASURE})
+    assert abs(got[("cone", "before")] - 35.0) < 5.0 and abs(got[("cone", "after")] - 20.0) < 5.0
+    assert got[("rotated_sector_mean", "before")] > got[("rotated_sector_mean", "after")] + 5.0
 
 
 def test_grid_points_are_found_from_their_overrides_and_tabulated(tmp_path):
@@ -36,9 +73,9 @@ def test_grid_points_are_found_from_their_overrides_and_tabulated(tmp_path):
     fake_run(tmp_path, 0.8, 0.05, 4, 44.0, 35.0, amplitude_mm=0.5)   # another vibration: its own grid point
     two = {"material": "M3-dry", "seeds": [5, 6],
            "job": {"overrides": grid.settings("M3-dry", 0.3, 0.4), "rig_config": rig(0.125)},
-           "replicas": [{"seed": 5, "status": "ok", "measurements": {"aor_mean_deg": 30.0, "pile_height_m": 0.07,
-                                                                      "surcharge_pile_height_m": 0.03}},
-                        {"seed": 6, "status": "failed", "measurements": {}}],
+           "replicas": [{"seed": 5, "status": "ok", "output_dir": "s5",
+                         "measurements": {"aor_mean_deg": 30.0, "pile_height_m": 0.07, "surcharge_pile_height_m": 0.03}},
+                        {"seed": 6, "status": "failed", "measurements": {}, "output_dir": "s6"}],
            "provenance": {"cpu_time_s": 50.0}}                      # two seeds in one job, one failed
     (tmp_path / "surcharge" / "two").mkdir()
     (tmp_path / "surcharge" / "two" / "result.json").write_text(json.dumps(two))
