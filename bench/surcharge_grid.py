@@ -31,6 +31,8 @@ import yaml
 
 ROOT = Path(__file__).resolve().parent.parent
 sys.path.insert(0, str(ROOT))
+from pycal.calibration.study_config import load_study  # noqa: E402
+from pycal.configs import load_numerics  # noqa: E402
 from pycal.files import write_text  # noqa: E402
 from pycal.post.aor import read_positions_csv  # noqa: E402
 from pycal.post.aor_readings import READINGS  # noqa: E402
@@ -38,7 +40,7 @@ from pycal.post.aor_readings import READINGS  # noqa: E402
 OTHER_READINGS = ("sector_median", "rotated_sector_mean", "cone")
 
 LIFT_SPEED_M_S = 0.01          # as the study's AoR stages and surcharge predictions
-G_M_S2 = 9.81
+SHIPPED_STUDY = ROOT / "configs" / "calibrations" / "zinc_ore.yaml"
 AMPLITUDE_KEYS = ("rig.procedure.vibration_amplitude_horizontal_m", "rig.procedure.vibration_amplitude_vertical_m")
 
 
@@ -51,15 +53,17 @@ def rig_vibration(procedure=None):
 
 
 def peak_acceleration_g(frequency_hz, amplitude_m):
-    """Peak acceleration of a sinusoid, in units of g: (2 pi f)^2 A / g."""
-    return (2 * math.pi * frequency_hz) ** 2 * amplitude_m / G_M_S2
+    """Peak acceleration of a sinusoid, in units of the rigs' g (configs/numerics.yaml): (2 pi f)^2 A / g."""
+    return (2 * math.pi * frequency_hz) ** 2 * amplitude_m / load_numerics()["gravity_m_s2"]
 
 
 def rolling_keys(material):
-    """The keys the study's rolling stage sets together: the material's pair and the walls'."""
-    return [f"interactions.{material}.rolling_resistance_coefficient",
-            "interactions.steel.rolling_resistance_coefficient",
-            "interactions.pvc.rolling_resistance_coefficient"]
+    """The keys the shipped study's rolling stage of the material sets together (its own or the one it inherits):
+    the material's pair and the walls'."""
+    for st in load_study(SHIPPED_STUDY)["materials"][material]:
+        if st["label"].startswith("rolling_resistance"):
+            return list(st["keys"] if st.get("kind") == "inherit" else st["parameter"]["keys"])
+    raise KeyError(f"{SHIPPED_STUDY}: no rolling-resistance stage for {material}")
 
 
 def settings(material, friction, rolling, amplitude_m=None):
@@ -88,13 +92,14 @@ def load(runs, material):
     """{(friction, rolling, (frequency Hz, horizontal m, vertical m)): [seed]} of the grid's runs in RUNS_DIR: one dict
     per seed (a job's replica: its measurements, its seed, and the job's CPU seconds shared out over its replicas)."""
     out = {}
+    rolling_key = rolling_keys(material)[0]
     for path in sorted((Path(runs) / "surcharge").glob("*/result.json")):
         r = json.loads(path.read_text())
         ov = (r.get("job") or {}).get("overrides") or {}
         if r.get("material") != material or ov.get("rig.procedure.lift_speed_m_s") != LIFT_SPEED_M_S:
             continue
         fr = ov.get(f"interactions.{material}.friction_coefficient")
-        rr = ov.get(rolling_keys(material)[0])
+        rr = ov.get(rolling_key)
         vib = rig_vibration(r["job"]["rig_config"]["procedure"])
         if fr is None or rr is None:
             continue
