@@ -6,7 +6,9 @@ A study keeps, per material, the overrides its stages found ({'particles.density
 material set each component's keys are prefixed with its name ('M2.particles...'), except
 a component's pairs with another component of the set: those are the set's
 cross_interactions, which take component values through the set's `from_components`
-rules (configs/material_sets/).
+rules (configs/material_sets/); a pair key such a rule reads (e.g. M3-wet's
+interactions.M2.cohesion.force_fraction, the weight part of the wet fines' hold on gravel)
+is kept, so that the rule carries its calibrated value.
 """
 import json
 from pathlib import Path
@@ -20,12 +22,16 @@ def overrides_for_material(study_overrides, material):
     from ..configs import load_material_set, material_set_names
     if material not in material_set_names():
         return dict(study_overrides.get(material, {}))
-    comps = load_material_set(material)["components"]
+    mset = load_material_set(material)
+    comps = mset["components"]
+    read = [(r["from"], r["key"]) for r in mset.get("from_components") or []]
     out = {}
     for m in comps:
         for k, v in study_overrides.get(m, {}).items():
             head = k.split(".")
-            if head[0] == "interactions" and len(head) > 1 and head[1] in comps and head[1] != m:
+            if (head[0] == "interactions" and len(head) > 1 and head[1] in comps and head[1] != m
+                    and not any(f == m and (k == key or k.startswith(key + ".") or key.startswith(k + "."))
+                                for f, key in read)):
                 continue
             out[f"{m}.{k}"] = v
     return out

@@ -71,6 +71,9 @@ class Study:
         self.jobs = []               # every job asked: section, rig, seed, job id, status (outputs: jobs.csv)
         self.t0 = time.time()
         self.eta = Eta(_workers_of(executor), cores=_local_cores(executor))
+        # (material, stage) -> the material set its runs use (a stage's material_set), else absent
+        self.stage_sets = {(m, st["label"]): st["material_set"] for m, sts in self.cfg["materials"].items()
+                           for st in sts if st.get("material_set")}
         self.stage_budget = None      # the running stage: (budget, runs requested before it, its index)
         self.provenance = study_provenance(self.config_path)
         self.journal = Journal(self.out / "journal.json")
@@ -89,13 +92,28 @@ class Study:
         budget = self.cfg.get("max_runs_count")
         return math.inf if not budget else budget - self.runs_requested
 
-    def _run_seeds(self, rig, material, overrides, seeds):
+    def job_material(self, material, stage, extra):
+        """(material or material set, overrides) of the runs of `stage` at the point `extra`:
+        the material with its values so far and `extra`; for a stage with a material_set,
+        that set with every component's values so far (pycal.calibration.calibrated) and
+        `extra`'s material keys as the stage's material's ('M3-wet.<key>')."""
+        mset = self.stage_sets.get((material, stage))
+        if not mset:
+            return material, {**self.overrides[material], **extra}
+        from .calibrated import overrides_for_material
+        values = dict(self.overrides)
+        values[material] = {**self.overrides[material], **{k: v for k, v in extra.items() if not k.startswith("rig.")}}
+        return mset, {**{k: v for k, v in extra.items() if k.startswith("rig.")},
+                      **overrides_for_material(values, mset)}
+
+    def _run_seeds(self, rig, material, overrides, seeds, eta_material=None):
         """One result per seed asked, in order. A seed the rig refuses (one packing that
         does not come to rest in time) is replaced by the next unused seed above them,
         with a warning; more than one failure per three seeds asked means the parameter
         point itself cannot run: RunError. Every job asked counts against the study's
         run budget (BudgetSpent before a job would exceed it). self.last_seeds: the
-        seeds that stand behind the results."""
+        seeds that stand behind the results. eta_material: the material the run costs are
+        booked to (default `material`; a set stage books them to the stage's material)."""
         wanted = list(seeds)
         results, used, failures, attempted = {}, {}, [], 0
         batch, next_seed = list(wanted), max(wanted) + 1
@@ -109,7 +127,7 @@ class Study:
             out = self.executor.run(jobs, raise_on_error=False)
             errors = list(getattr(self.executor, "last_errors", []))
             self.record_jobs(jobs, out)
-            self.eta.add(material, rig, out)
+            self.eta.add(eta_material or material, rig, out)
             slots = [s for s in wanted if s not in results]
             retry = []
             for slot, seed, r in zip(slots, batch, out):
@@ -175,7 +193,7 @@ class Study:
         used = self._stage_seeds.setdefault((material, stage, rig), [])
         count = count or len(self.seeds)
         seeds = self.seeds[:count] if not used else list(range(max(used) + 1, max(used) + 1 + count))
-        results = self._run_seeds(rig, material, {**self.overrides[material], **extra}, seeds)
+        results = self._run_seeds(rig, *self.job_material(material, stage, extra), seeds, eta_material=material)
         used += self.last_seeds
         values = [[math.nan if v is None else v for v in (response.value(r, lab_dir) for r in results)]
                   for response in responses]
@@ -252,9 +270,9 @@ class Study:
         """The journal of a stage (pycal.calibration.journal), keyed by what it starts from:
         its config, the seeds, its targets and the material's values so far."""
         tg = [t.__dict__ for t in self.targets[(material, st["label"])]]
+        values = self.job_material(material, st["label"], {})[1]    # a set stage: every component's values
         return self.journal.stage(f"{material}/{st['label']}",
-                                  fingerprint(st, self.seeds, sorted(self.overrides[material].items()), tg,
-                                              SEED_SCHEME))
+                                  fingerprint(st, self.seeds, sorted(values.items()), tg, SEED_SCHEME))
 
     def seeds_from_base(self, count):
         """`count` seeds from the study's seed base: seed_base, seed_base + 1, ..."""

@@ -19,6 +19,10 @@ A parameter group:
               tolerance_coefficient, tolerance_pa, tolerance_kg_m3, tolerance_fraction)
   response_increases         1-D stages: the direction physics gives the response (required)
   response_slope_estimate    1-D stages, optional: |d response / d parameter| from physics
+A 1-D stage's material_set (optional): the stage runs its rig on that set of
+configs/material_sets/ (its material must be a component; the other components take the
+values the study has found for them) and moves its material's keys, e.g. the weight part
+of the wet fines' hold on gravel on the wet -50 mm pile.
 A stage's run_at (optional): material keys and the values the stage's runs use instead of
 the study's current ones, not carried into the calibrated set (e.g. the friction stages
 at a cheaper Young's modulus the friction responses are measured not to depend on).
@@ -238,13 +242,34 @@ def _check_overrides(c, st, key, material=None, mat_cfg=None):
             c.fail(f"{key}.run_at.{k}", f"no such key in configs/materials/{material}.yaml")
 
 
+def _material_set(c, st, key, material):
+    """A stage's material_set: a set of configs/material_sets/ with `material` as a
+    component, on a rig that takes sets."""
+    from .. import rigs
+    from ..configs import load_material_set, material_set_names
+    name = st["material_set"]
+    if not isinstance(name, str) or name not in material_set_names():
+        c.fail(f"{key}.material_set", f"{name!r}: no such material set (configs/material_sets: "
+                                      f"{', '.join(material_set_names())})")
+    comps = load_material_set(name)["components"]
+    if material not in comps:
+        c.fail(f"{key}.material_set", f"{name} has no component {material} (its components: {', '.join(comps)}): "
+                                      f"the stage moves {material}'s keys")
+    if st.get("run_at"):
+        c.fail(f"{key}.run_at", "not with material_set (the run_at check reruns a stage on its material alone)")
+    if st.get("rig") in rigs.names() and not rigs.get(st["rig"]).accepts_material_sets:
+        c.fail(f"{key}.material_set", f"rig {st['rig']} takes one material, not a set (pycal/rigs/{st['rig']}.py)")
+
+
 def _one_d(c, st, key, material, mat_cfg, seeds):
     kind = st["stage"]
     _check_removed(c, st, key)
     c.keys(st, key, ["stage", "rig", "parameter"] + ([] if kind == "density" else ["response"]),
            ["name", "response", "target", "rig_overrides", "run_at", "set", "max_runs_count", "lab_dir",
-            "out_of_reach_factor"])
+            "out_of_reach_factor", "material_set"])
     _check_overrides(c, st, key, material, mat_cfg)
+    if "material_set" in st:
+        _material_set(c, st, key, material)
     response = _response(c, st.get("response", "bulk_density_kg_m3"), f"{key}.response")
     _rig_response(c, st["rig"], response, key)
     _lab_angle_exists(c, st.get("target") or {}, f"{key}.target", st.get("lab_dir"))
@@ -254,6 +279,7 @@ def _one_d(c, st, key, material, mat_cfg, seeds):
            "target": _target(c, st.get("target"), f"{key}.target", response),
            "rig_overrides": dict(st.get("rig_overrides") or {}), "set": dict(st.get("set") or {}),
            "run_at": dict(st.get("run_at") or {}), "lab_dir": st.get("lab_dir"),
+           "material_set": st.get("material_set"),
            "parameter": _parameter(c, st["parameter"], f"{key}.parameter", material, mat_cfg, kind, True)}
     out["max_runs_count"] = int(c.number(st.get("max_runs_count", DEFAULT_POINTS_COUNT * seeds),
                                          f"{key}.max_runs_count", 2 * seeds))

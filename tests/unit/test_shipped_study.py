@@ -1,7 +1,8 @@
 """The shipped study (configs/calibrations/zinc_ore.yaml) from its first stage to its last on
 fake rigs: every stage kind runs (density, rolling resistance, stiffness in log E, wall
 friction, inheritance, the wet cohesion from the wet internal-friction curve, the
-wet wall joint fit, the final rolling resistance + density pass), the outputs and the report
+wet wall joint fit, the final rolling resistance + density pass, the wet fines' hold on
+gravel on the wet -50 mm pile, a stage on a material set), the outputs and the report
 are written. The fake laws are smooth and the noise small: this checks the plumbing of the
 real config, not its numbers (those need YADE)."""
 import math
@@ -37,10 +38,20 @@ def internal(job):
             "mu_dynamic": [None if st else m for m, st in zip(mu, sticks)], "sticks": sticks}
 
 
+def cross_hold_angle_deg(force_fraction):
+    """The wet mixed pile's angle (deg) at the weight part of the fines' hold on gravel."""
+    return 90.0 - 50.0 * math.exp(-force_fraction / 4.0)
+
+
 def mixed_pile(job):
-    """The mixed -50 mm pile (validation): every direction and the upper part at 35 deg."""
-    return {k: 35.0 for k in ("aor_left_deg", "aor_right_deg", "aor_front_deg", "aor_back_deg",
+    """The mixed -50 mm pile: dry, every direction and the upper part at 35 deg; wet, every
+    direction at cross_hold_angle_deg of the fines-gravel pair's weight part (M2 - M3-wet)."""
+    angle = 35.0
+    if job["material"] == "mixed-wet":
+        angle = cross_hold_angle_deg(job["materials"]["M2"]["interactions"]["M3-wet"]["cohesion"]["force_fraction"])
+    out = {k: angle for k in ("aor_left_deg", "aor_right_deg", "aor_front_deg", "aor_back_deg",
                               "aor_upper_left_deg", "aor_upper_right_deg")}
+    return dict(out, aor_mean_deg=angle)
 
 
 def surcharge(job):
@@ -105,6 +116,14 @@ def test_the_shipped_study_runs_every_stage_on_fake_rigs(tmp_path, fake_stiffnes
     assert [p["label"] for p in final["parameters"]] == ["rolling resistance (M2, steel, PVC)", "particle density"]
     assert len(final["correlation"]) == 2
     assert all(j["seed"] >= 7 for j in ex.asked)
+    # the wet fines' hold on gravel, on the wet -50 mm pile (a set): the weight part whose pile reads 88 deg
+    cross = by[("M3-wet", "cross_binding")]["parameters"][0]
+    root = -4.0 * math.log((90.0 - 88.0) / 50.0)
+    assert cross["low"] <= root <= cross["high"] and abs(cross["estimate"] / root - 1) < 0.1
+    assert any(j["rig"] == "aor_mixed" and j["material"] == "mixed-wet" for j in ex.asked)
+    wet_jobs = [j for j in ex.asked if j["rig"] == "transfer" and j["material"] == "mixed-wet"]
+    assert wet_jobs and all(j["materials"][m]["interactions"]["M3-wet"]["cohesion"]["force_fraction"]
+                            == cross["estimate"] for j in wet_jobs for m in ("M1", "M2"))
     # validation: every prediction of the shipped config ran with the calibrated values
     names = [r["prediction"] for r in study.validation_rows]
     assert names == [p["name"] for p in study.cfg["validation"]["predictions"]]

@@ -219,9 +219,9 @@ def test_every_stage_runs_through_run_seeds(tmp_path, study_file, monkeypatch):
     calls = []
     original = Study._run_seeds
 
-    def spy(self, rig, material, overrides, seeds):
+    def spy(self, rig, material, overrides, seeds, **kw):
         calls.append((rig, list(seeds)))
-        return original(self, rig, material, overrides, seeds)
+        return original(self, rig, material, overrides, seeds, **kw)
     monkeypatch.setattr(Study, "_run_seeds", spy)
     ex = FakeRigs()
     Study(study_file, ex, tmp_path / "out", log=quiet).run()

@@ -92,30 +92,32 @@ def test_a_scalar_comparison_needs_one_band(tmp_path):
 def test_a_calibrated_subtree_with_its_leaves_reaches_the_sets_cross_pairs():
     """A stage switched the fines-steel pair to hysteretic (a whole subtree) and a later stage
     moved its pressure_fraction: through the set's from_components rules the wet fines'
-    pairs with gravel and lumps get the switched pair with the moved leaf."""
+    pairs with gravel and lumps get the switched pair with the moved leaf, and the weight
+    part of each pair is the fines' own on that partner (a calibrated one included)."""
     from pycal.calibration.calibrated import overrides_for_material
     from pycal.jobs import resolve_job
     study = {"M3-wet": {"interactions.steel.cohesion": {"model": "hysteretic", "force_fraction": 0.0,
                                                         "pressure_fraction": 0.0, "update_interval_s": 0.01},
                         "interactions.steel.cohesion.pressure_fraction": 0.012,
                         "interactions.M3-wet.friction_coefficient": 0.41,
+                        "interactions.M2.cohesion.force_fraction": 7.0,   # read by a rule: applied
                         "interactions.M2.friction_coefficient": 0.99}}   # a pair inside the set: not applied
     job = resolve_job("aor_mixed", "mixed-wet", overrides_for_material(study, "mixed-wet"))
-    want = {"model": "hysteretic", "force_fraction": 0.0, "pressure_fraction": 0.012, "update_interval_s": 0.01}
-    for coarse in ("M1", "M2"):
+    want = {"model": "hysteretic", "pressure_fraction": 0.012, "update_interval_s": 0.01}
+    for coarse, weight_part in (("M1", 0.3), ("M2", 7.0)):       # M1: the config's fines-lumps value
         pair = job["materials"][coarse]["interactions"]["M3-wet"]
-        assert pair["cohesion"] == want and pair["friction_coefficient"] == 0.41
+        assert pair["cohesion"] == dict(want, force_fraction=weight_part) and pair["friction_coefficient"] == 0.41
         assert job["materials"]["M3-wet"]["interactions"][coarse] == pair
-    # no calibrated value: the shipped fines-wall adhesion
+    # no calibrated value: the shipped fines-wall adhesion with the fines-gravel weight part
     job0 = resolve_job("aor_mixed", "mixed-wet")
-    assert job0["materials"]["M2"]["interactions"]["M3-wet"]["cohesion"] == \
-        job0["materials"]["M3-wet"]["interactions"]["steel"]["cohesion"]
+    steel = job0["materials"]["M3-wet"]["interactions"]["steel"]["cohesion"]
+    assert job0["materials"]["M2"]["interactions"]["M3-wet"]["cohesion"] == dict(steel, force_fraction=0.3)
 
 
 def test_a_set_override_wins_over_the_component_value_it_would_take():
     from pycal.jobs import resolve_job
     job = resolve_job("aor_mixed", "mixed-wet", {"cross_interactions.M2.M3-wet.cohesion.force_fraction": 1.0,
-                                                 "M3-wet.interactions.steel.cohesion.force_fraction": 0.2})
+                                                 "M3-wet.interactions.M1.cohesion.force_fraction": 0.2})
     assert job["materials"]["M2"]["interactions"]["M3-wet"]["cohesion"]["force_fraction"] == 1.0
     assert job["materials"]["M1"]["interactions"]["M3-wet"]["cohesion"]["force_fraction"] == 0.2
 
