@@ -120,7 +120,9 @@ def test_the_shipped_study_runs_every_stage_on_fake_rigs(tmp_path, fake_stiffnes
     cross = by[("M3-wet", "cross_binding")]["parameters"][0]
     root = -4.0 * math.log((90.0 - 88.0) / 50.0)
     assert cross["low"] <= root <= cross["high"] and abs(cross["estimate"] / root - 1) < 0.1
-    assert any(j["rig"] == "aor_mixed" and j["material"] == "mixed-wet" for j in ex.asked)
+    stage_jobs = [j for j in ex.asked if j["rig"] == "aor_mixed" and j["material"] == "mixed-wet"]
+    assert stage_jobs and all(j["materials"]["M2"]["particles"]["density_kg_m3"]      # the gravel as calibrated
+                              == study.overrides["M2"]["particles.density_kg_m3"] for j in stage_jobs)
     wet_jobs = [j for j in ex.asked if j["rig"] == "transfer" and j["material"] == "mixed-wet"]
     assert wet_jobs and all(j["materials"][m]["interactions"]["M3-wet"]["cohesion"]["force_fraction"]
                             == cross["estimate"] for j in wet_jobs for m in ("M1", "M2"))
