@@ -105,7 +105,8 @@ def _points_table(points):
 
 
 def _stage_detail(study_dir, s, history=()):
-    parts = [f"<h3>{_esc(s['material'])}: {_esc(s['stage'])}</h3>"]
+    on_set = f" (runs on the material set {_esc(s['material_set'])})" if s.get("material_set") else ""
+    parts = [f"<h3>{_esc(s['material'])}: {_esc(s['stage'])}{on_set}</h3>"]
     lines = []
     for r in s.get("responses") or []:
         if "at_estimate" not in r:

@@ -32,6 +32,12 @@ def held_values(study, material, st):
             except (KeyError, TypeError):
                 continue                    # a key a later stage's `set` brings in: not held here
         out.append({"key": k, "value": value, "source": source})
+    if st.get("material_set"):                # a set stage: the other components as the study has them
+        from ..configs import load_material_set
+        for m in load_material_set(st["material_set"])["components"]:
+            if m != material:
+                out += [{"key": f"{m}.{k}", "value": v, "source": f"calibrated: {study.value_source[m].get(k, '?')}"}
+                        for k, v in study.overrides.get(m, {}).items()]
     for k, v in (st.get("rig_overrides") or {}).items():
         out.append({"key": k, "value": v, "source": "rig override of this stage"})
     for r in st.get("responses") or []:

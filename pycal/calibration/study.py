@@ -367,7 +367,8 @@ class Study:
                                                       getattr(self.executor, "simulated_count", 0) - simulated_before)
                 row.update({"material": material, "stage": st["label"], "kind": st["kind"],
                             "runs_requested": self.runs_requested - runs_before,
-                            "runs_simulated": simulated, "elapsed_s": round(elapsed, 1)})
+                            "runs_simulated": simulated, "elapsed_s": round(elapsed, 1),
+                            "material_set": st.get("material_set")})
                 row.setdefault("plots", [])
                 row["held"] = held
                 row["matches_lab"] = matches_lab(row)

@@ -123,6 +123,8 @@ def test_the_shipped_study_runs_every_stage_on_fake_rigs(tmp_path, fake_stiffnes
     stage_jobs = [j for j in ex.asked if j["rig"] == "aor_mixed" and j["material"] == "mixed-wet"]
     assert stage_jobs and all(j["materials"]["M2"]["particles"]["density_kg_m3"]      # the gravel as calibrated
                               == study.overrides["M2"]["particles.density_kg_m3"] for j in stage_jobs)
+    held = {h["key"]: h["value"] for h in by[("M3-wet", "cross_binding")]["held"]}
+    assert held["M2.particles.density_kg_m3"] == study.overrides["M2"]["particles.density_kg_m3"]
     wet_jobs = [j for j in ex.asked if j["rig"] == "transfer" and j["material"] == "mixed-wet"]
     assert wet_jobs and all(j["materials"][m]["interactions"]["M3-wet"]["cohesion"]["force_fraction"]
                             == cross["estimate"] for j in wet_jobs for m in ("M1", "M2"))
@@ -141,3 +143,4 @@ def test_the_shipped_study_runs_every_stage_on_fake_rigs(tmp_path, fake_stiffnes
     assert (wet_t["responses"][-1]["true_count"], dry_t["responses"][-1]["true_count"]) == (3, 0)
     html = write_report(study.out).read_text()
     assert "YADE 2023.02a-fake" in html and "rolling_density_final" in html and "Application (design runs" in html
+    assert "cross_binding (runs on the material set mixed-wet)" in html
