@@ -268,7 +268,8 @@ class Study:
 
     def stage_journal(self, material, st):
         """The journal of a stage (pycal.calibration.journal), keyed by what it starts from:
-        its config, the seeds, its targets and the material's values so far."""
+        its config, the seeds, its targets and the material's values so far (a stage on a
+        material set: every component's)."""
         tg = [t.__dict__ for t in self.targets[(material, st["label"])]]
         values = self.job_material(material, st["label"], {})[1]    # a set stage: every component's values
         return self.journal.stage(f"{material}/{st['label']}",
