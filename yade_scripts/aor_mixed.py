@@ -6,8 +6,9 @@ Fill the 145 x 95 mm PVC cylinder on the steel table with the set's particles by
 shapes' shares, random non-overlapping placement in a column, pour, settle, strike
 level: spheres above the rim are removed, lumps stay), lift the cylinder at
 lift_speed_m_s until clear, settle the pile, measure the sector angles of the whole
-slope and of the upper half of the pile height (pycal/post/aor_mixed.py). Every particle sphere,
-clump members included, is a particle of the profile.
+slope and of the upper half of the pile height (pycal/post/aor_mixed.py), and the share of the
+pile's volume inside the cylinder's footprint (pycal.post.aor.footprint_fraction). Every particle
+sphere, clump members included, is a particle of the profile.
 Outputs: pile_particles.csv (with material and clump id), pile_profile.csv,
 pile_upper_profile.csv, pile_side.png, result.json.
 Run: yade -j1 -x -n yade_scripts/aor_mixed.py job.json
@@ -47,7 +48,9 @@ def procedure(scene, out_dir):
         print(line, flush=True)
     out = post.result_keys(whole, upper)
     out.update({"n_particles": whole["n_particles"], "pile_height_m": whole["pile_height_m"],
-                "pile_radius_m": whole["pile_radius_m"]})
+                "pile_radius_m": whole["pile_radius_m"],
+                "pile_footprint_fraction": aor_post.footprint_fraction(
+                    post.positions(rows), scene.rig["geometry"]["cell_inner_diameter_m"] / 2.0)})
     out.update(info)
     return out
 

@@ -25,6 +25,10 @@ Method - the pile's silhouette, as a gauge laid on the flank sees it
    counted as 0 degrees.
 6. pile_height_m = highest particle top - table_z_m; pile_radius_m = largest horizontal
    distance of a particle edge from the pile centre.
+   footprint_fraction (the mixed-set rig's pile_footprint_fraction): the share of the
+   particle volume inside the lifted cylinder's footprint (a standing pile ~1, a cone
+   less); it tells a pile that keeps its faces from one that slumps where the bumpy
+   silhouette of a standing face of 25 mm spheres reads anything from 60 to 90 deg.
 7. A flank fit is flagged (`flank_flags`; the report and the side view mark it, the
    angle is kept) when it differs from the sector's whole silhouette (Theil-Sen slope
    through every slice, toe and apex included: robust to one stray point) by more than
@@ -171,6 +175,24 @@ def measure_pile(positions, slice_height_m, exclude_bottom_m, exclude_apex_m, ha
         "pile_height_m": top - table_z_m,
         "pile_radius_m": float(np.max(rh)),
     }
+
+
+def footprint_fraction(positions, footprint_radius_m, axis_xy=(0.0, 0.0)):
+    """Share (0 - 1) of the pile's particle volume inside the vertical cylinder of radius
+    footprint_radius_m (m) about axis_xy (m): what the pile keeps of the lifted cylinder's
+    footprint. Each sphere counts with the part of its volume on the inner side of the
+    cylinder's wall, the wall taken as a plane at the sphere's scale: with
+    h = (footprint_radius_m - distance of its centre from the axis) / radius clipped to
+    [-1, 1], the inner part is 1/2 + 3h/4 - h^3/4 of the sphere (a spherical cap). A pile
+    that keeps the cylinder's shape reads ~1; a cone spread on the table less."""
+    a = as_array(positions)
+    if len(a) == 0:
+        raise ValueError("no particles to measure")
+    rho = np.hypot(a[:, 0] - axis_xy[0], a[:, 1] - axis_xy[1])
+    h = np.clip((footprint_radius_m - rho) / a[:, 3], -1.0, 1.0)
+    inside = 0.5 + 0.75 * h - 0.25 * h ** 3
+    volume = a[:, 3] ** 3
+    return float(np.sum(volume * inside) / np.sum(volume))
 
 
 def measure_from_config(positions, measure_cfg, table_z_m=0.0):

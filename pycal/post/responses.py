@@ -86,6 +86,8 @@ RESPONSES = {r.name: r for r in [
              description="bulk density of the struck cell fill"),
     Response("aor_mean_deg", "deg", False, _scalar("aor_mean_deg"),
              description="angle of repose, mean over the pile's sectors"),
+    Response("pile_footprint_fraction", "fraction", False, _scalar("pile_footprint_fraction"),
+             description="share of the pile's volume inside the lifted cylinder's footprint"),
     Response("unloading_stiffness_log_ratio", "log_ratio", False, _log_ratio, _compression_plots,
              "ln(simulated / lab unloading stiffness), mean over the lab steps >= 10 kPa"),
     Response("friction_offset_mu_static", "mu", False, _offset("mu_static"), _friction_plots,

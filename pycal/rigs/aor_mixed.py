@@ -11,6 +11,7 @@ DESCRIPTOR = RigDescriptor(
                "strike_level_height_m") + LIFT,
     measure=PILE_READING + ("upper_fit_from_height_fraction", "upper_silhouette_slice_height_m",
                             "upper_exclude_apex_m"),
-    phases=phases, result_keys=AOR_RESULT + ("aor_upper_mean_deg",), responses=("aor_mean_deg",),
+    phases=phases, result_keys=AOR_RESULT + ("aor_upper_mean_deg", "pile_footprint_fraction"),
+    responses=("aor_mean_deg", "pile_footprint_fraction"),
     accepts_material_sets=True, check_job=particle_fits_cell, post="aor_mixed",
     pictures=("pile_side.png",))

@@ -190,3 +190,58 @@ def test_the_profile_refit_reads_the_run_s_angles_and_the_side_view_marks_a_doub
               if l.get_label().startswith(("left", "right"))}
     assert styles == {"left": "-", "right": "--"}
     assert "right 90.0?" in fig.axes[0].get_title()
+
+
+# ---------- the share of the pile inside the lifted cylinder's footprint ----------
+
+FOOT_R = 0.0725          # the cell's inner radius, m
+
+
+def grid_body(inside, extent, height, spacing=0.003):
+    """Spheres of radius spacing / 2 on a cubic grid, those whose centre satisfies
+    inside(rho, z) (m): a solid body of known volume in small equal spheres."""
+    r = spacing / 2.0
+    xs = np.arange(-extent, extent + 1e-12, spacing)
+    zs = np.arange(r, height, spacing)
+    x, y, z = np.meshgrid(xs, xs, zs, indexing="ij")
+    keep = inside(np.hypot(x, y), z)
+    return np.column_stack([x[keep], y[keep], z[keep], np.full(int(keep.sum()), r)])
+
+
+def test_one_sphere_counts_its_volume_on_the_inner_side_of_the_wall():
+    r = 0.0125
+    on_wall = [(FOOT_R, 0.0, r, r)]
+    assert aor.footprint_fraction(on_wall, FOOT_R) == pytest.approx(0.5)
+    # centre r/2 inside the wall: the outer cap has height r/2, volume pi (r/2)^2 (3r - r/2) / 3
+    # = 5/32 of the sphere
+    half_in = [(0.0, -(FOOT_R - r / 2), r, r)]
+    assert aor.footprint_fraction(half_in, FOOT_R) == pytest.approx(1 - 5 / 32)
+    assert aor.footprint_fraction([(0.0, 0.0, r, r)], FOOT_R) == 1.0
+    assert aor.footprint_fraction([(0.2, 0.0, r, r)], FOOT_R) == 0.0
+    # the axis is where the cylinder stood, not the origin
+    assert aor.footprint_fraction([(1.0 + FOOT_R, 2.0, r, r)], FOOT_R, axis_xy=(1.0, 2.0)) == pytest.approx(0.5)
+
+
+def test_a_pile_that_keeps_the_cylinder_s_shape_reads_one():
+    body = grid_body(lambda rho, z: rho <= FOOT_R - 0.0015, FOOT_R, 0.095)
+    assert aor.footprint_fraction(body, FOOT_R) == pytest.approx(1.0)
+
+
+@pytest.mark.parametrize("base_radius_m", [0.1, 0.15])
+def test_a_cone_reads_the_share_of_its_volume_inside_the_footprint(base_radius_m):
+    height = 0.1
+    body = grid_body(lambda rho, z: z <= height * (1 - rho / base_radius_m), base_radius_m, height)
+    # volume within radius R of a cone (base Rb, height H): 2 pi H (R^2 / 2 - R^3 / (3 Rb)); whole: pi Rb^2 H / 3
+    inside = 2 * math.pi * height * (FOOT_R ** 2 / 2 - FOOT_R ** 3 / (3 * base_radius_m))
+    whole = math.pi * base_radius_m ** 2 * height / 3
+    assert aor.footprint_fraction(body, FOOT_R) == pytest.approx(inside / whole, abs=0.01)
+
+
+def test_faces_leaning_two_degrees_out_keep_about_95_percent():
+    height, lean = 0.1, math.radians(2.0)
+    base = FOOT_R + height * math.tan(lean)
+    body = grid_body(lambda rho, z: rho <= base - z * math.tan(lean), base, height, spacing=0.002)
+    # a frustum with the cylinder's radius on top: pi R^2 H of pi H (R^2 + R Rb + Rb^2) / 3 lies inside
+    expected = 3 * FOOT_R ** 2 / (FOOT_R ** 2 + FOOT_R * base + base ** 2)
+    assert expected == pytest.approx(0.953, abs=0.001)
+    assert aor.footprint_fraction(body, FOOT_R) == pytest.approx(expected, abs=0.005)
