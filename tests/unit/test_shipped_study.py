@@ -38,20 +38,23 @@ def internal(job):
             "mu_dynamic": [None if st else m for m, st in zip(mu, sticks)], "sticks": sticks}
 
 
-def cross_hold_angle_deg(force_fraction):
-    """The wet mixed pile's angle (deg) at the weight part of the fines' hold on gravel."""
-    return 90.0 - 50.0 * math.exp(-force_fraction / 4.0)
+def cross_hold_footprint_fraction(force_fraction):
+    """The share of the wet mixed pile inside the cylinder's footprint at the weight part of
+    the fines' hold on gravel: 0.65 (a cone) without hold, 1 (it stands) at a strong one."""
+    return 1.0 - 0.35 * math.exp(-force_fraction / 4.0)
 
 
 def mixed_pile(job):
-    """The mixed -50 mm pile: dry, every direction and the upper part at 35 deg; wet, every
-    direction at cross_hold_angle_deg of the fines-gravel pair's weight part (M2 - M3-wet)."""
-    angle = 35.0
+    """The mixed -50 mm pile: dry, every direction and the upper part at 35 deg and 0.7 of it
+    inside the footprint; wet, cross_hold_footprint_fraction of the fines-gravel pair's weight
+    part (M2 - M3-wet)."""
+    angle, share = 35.0, 0.7
     if job["material"] == "mixed-wet":
-        angle = cross_hold_angle_deg(job["materials"]["M2"]["interactions"]["M3-wet"]["cohesion"]["force_fraction"])
+        share = cross_hold_footprint_fraction(
+            job["materials"]["M2"]["interactions"]["M3-wet"]["cohesion"]["force_fraction"])
     out = {k: angle for k in ("aor_left_deg", "aor_right_deg", "aor_front_deg", "aor_back_deg",
                               "aor_upper_left_deg", "aor_upper_right_deg")}
-    return dict(out, aor_mean_deg=angle)
+    return dict(out, aor_mean_deg=angle, pile_footprint_fraction=share)
 
 
 def surcharge(job):
@@ -116,9 +119,11 @@ def test_the_shipped_study_runs_every_stage_on_fake_rigs(tmp_path, fake_stiffnes
     assert [p["label"] for p in final["parameters"]] == ["rolling resistance (M2, steel, PVC)", "particle density"]
     assert len(final["correlation"]) == 2
     assert all(j["seed"] >= 7 for j in ex.asked)
-    # the wet fines' hold on gravel, on the wet -50 mm pile (a set): the weight part whose pile reads 88 deg
+    # the wet fines' hold on gravel, on the wet -50 mm pile (a set): the weight part whose pile keeps
+    # the stage's target share (faces leaning 2 deg out) of its volume inside the footprint
     cross = by[("M3-wet", "cross_binding")]["parameters"][0]
-    root = -4.0 * math.log((90.0 - 88.0) / 50.0)
+    target = study.cfg["materials"]["M3-wet"][-1]["target"]["value"]
+    root = -4.0 * math.log((1.0 - target) / 0.35)
     assert cross["low"] <= root <= cross["high"] and abs(cross["estimate"] / root - 1) < 0.1
     stage_jobs = [j for j in ex.asked if j["rig"] == "aor_mixed" and j["material"] == "mixed-wet"]
     assert stage_jobs and all(j["materials"]["M2"]["particles"]["density_kg_m3"]      # the gravel as calibrated
