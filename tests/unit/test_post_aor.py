@@ -245,3 +245,22 @@ def test_faces_leaning_two_degrees_out_keep_about_95_percent():
     expected = 3 * FOOT_R ** 2 / (FOOT_R ** 2 + FOOT_R * base + base ** 2)
     assert expected == pytest.approx(0.953, abs=0.001)
     assert aor.footprint_fraction(body, FOOT_R) == pytest.approx(expected, abs=0.005)
+
+
+def test_the_lab_wet_pile_with_its_front_slumped_to_32_degrees_keeps_89_percent():
+    """The cross_binding stage's target (configs/calibrations/zinc_ore.yaml): three quarters of
+    the cylinder standing (0.095 m high), the front quarter slumped to a cone at 32 deg about the
+    axis that keeps its quarter's volume."""
+    height, slope = 0.095, math.tan(math.radians(32.0))
+    # per radian of azimuth: the cylinder holds H R^2 / 2, a cone of base b holds slope b^3 / 6
+    base = (3 * height * FOOT_R ** 2 / slope) ** (1 / 3)
+    front_inside = slope * (base * FOOT_R ** 2 / 2 - FOOT_R ** 3 / 3) / (height * FOOT_R ** 2 / 2)
+    expected = 0.75 + 0.25 * front_inside
+    assert expected == pytest.approx(0.89, abs=0.002)
+    r = 0.0015
+    xs = np.arange(-base, base + 1e-12, 2 * r)
+    x, y, z = np.meshgrid(xs, xs, np.arange(r, height, 2 * r), indexing="ij")
+    rho, front = np.hypot(x, y), (y < -np.abs(x))            # the front quarter: azimuth -135 .. -45 deg
+    keep = np.where(front, z <= slope * (base - rho), (rho <= FOOT_R) & (z <= height))
+    body = np.column_stack([x[keep], y[keep], z[keep], np.full(int(keep.sum()), r)])
+    assert aor.footprint_fraction(body, FOOT_R) == pytest.approx(expected, abs=0.01)
