@@ -62,6 +62,7 @@ VARIANTS = {
     "rolling resistance on steel 0.6 (fines, gravel)": (tuple(SETS), lambda job, fines: no_roll(fines)),
     "... and friction on steel 0.7": (tuple(SETS), lambda job, fines: no_roll_no_slide(fines)),
     "wet plate adhesion 0.05 (the wall stage's bound)": (("mixed-wet",), lambda job, fines: plate_adhesion(job, 0.05)),
+    "wet plate adhesion 0.1": (("mixed-wet",), lambda job, fines: plate_adhesion(job, 0.1)),
     "wet plate adhesion 0.2": (("mixed-wet",), lambda job, fines: plate_adhesion(job, 0.2)),
     "wet plate adhesion 0.2, rolling 0.6, friction 0.7": (
         ("mixed-wet",), lambda job, fines: {**plate_adhesion(job, 0.2), **no_roll_no_slide(fines)}),
