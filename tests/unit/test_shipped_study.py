@@ -57,10 +57,19 @@ def mixed_pile(job):
     return dict(out, aor_mean_deg=angle, pile_footprint_fraction=share)
 
 
+SURCHARGE_FRICTION_ROOT = 0.7    # the dry fines' particle friction whose fake surcharge reads the lab's 28 deg
+
+
 def surcharge(job):
-    """The surcharge angle (validation): 0.6 x the fake AoR law."""
-    a = 0.6 * aor_law(job)
-    return {"surcharge_left_deg": a, "surcharge_right_deg": a}
+    """The surcharge run: the pile before the vibration (the fake AoR law) and after it, 10 deg
+    lower at particle friction 0.7 and 20 deg per unit of particle friction (so that at the
+    dry fines' lab AoR, 38 deg, the lab's 28 deg after needs friction 0.7)."""
+    name = job["material"]
+    mu = job["materials"][name]["interactions"][name]["friction_coefficient"]
+    before = aor_law(job)
+    after = before - 10.0 + 20.0 * (mu - SURCHARGE_FRICTION_ROOT)
+    return {"aor_mean_deg": before, "surcharge_mean_deg": after, "surcharge_left_deg": after,
+            "surcharge_right_deg": after}
 
 
 def ucs(job):
@@ -118,6 +127,18 @@ def test_the_shipped_study_runs_every_stage_on_fake_rigs(tmp_path, fake_stiffnes
     final = by[("M2", "rolling_density_final")]
     assert [p["label"] for p in final["parameters"]] == ["rolling resistance (M2, steel, PVC)", "particle density"]
     assert len(final["correlation"]) == 2
+    # the dry fines' final pass reads the pile before and after the vibration of one surcharge run:
+    # the friction whose vibrated pile reads the lab's angle, and the wet fines inherit it
+    dry = by[("M3-dry", "friction_rolling_density_final")]
+    mu = dry["parameters"][0]
+    assert mu["keys"] == ["interactions.M3-dry.friction_coefficient"] and len(dry["correlation"]) == 3
+    assert mu["low"] <= SURCHARGE_FRICTION_ROOT <= mu["high"]
+    assert abs(mu["estimate"] - SURCHARGE_FRICTION_ROOT) < 0.1
+    dry_jobs = [j for j in ex.asked if j["material"] == "M3-dry" and j["rig"] in ("surcharge", "aor")]
+    assert {j["rig"] for j in dry_jobs} == {"aor", "surcharge"}       # the rolling stage on aor, the final pass on surcharge
+    wet_cohesion_jobs = [j for j in ex.asked if j["material"] == "M3-wet" and j["rig"] == "internal_friction"]
+    assert wet_cohesion_jobs and all(j["materials"]["M3-wet"]["interactions"]["M3-wet"]["friction_coefficient"]
+                                     == mu["estimate"] for j in wet_cohesion_jobs)
     assert all(j["seed"] >= 7 for j in ex.asked)
     # the wet fines' hold on gravel, on the wet -50 mm pile (a set): the weight part whose pile keeps
     # the stage's target share (faces leaning 2 deg out) of its volume inside the footprint

@@ -322,10 +322,14 @@ def test_shipped_study_config_is_valid():
     # and a final pass over rolling resistance and density after the friction stages
     wet = next(st for st in cfg["materials"]["M3-wet"] if st["label"] == "cohesion")
     assert wet["rig"] == "internal_friction" and wet["response"] == "friction_angle_offset_deg"
-    for m in ("M2", "M3-dry"):
+    for m, final in (("M2", "rolling_density_final"), ("M3-dry", "friction_rolling_density_final")):
         labels = [st["label"] for st in cfg["materials"][m]]
-        assert labels[-1] == "rolling_density_final" and kinds[(m, labels[-1])] == "joint"
-        assert labels.index("wall_friction") < labels.index("rolling_density_final")
+        assert labels[-1] == final and kinds[(m, labels[-1])] == "joint"
+        assert labels.index("wall_friction") < labels.index(final)
+    # the dry fines' final pass reads the surcharge run's pile before and after the vibration
+    dry = cfg["materials"]["M3-dry"][-1]
+    assert [(r["rig"], r["response"]) for r in dry["responses"]] == [
+        ("surcharge", "aor_mean_deg"), ("surcharge", "surcharge_mean_deg"), ("fill", "bulk_density_kg_m3")]
 
 
 @pytest.fixture
