@@ -36,12 +36,19 @@ def table(points):
     """The markdown table of stage_points' output: one row per point."""
     if not points:
         return ""
-    keys = list(points[0][0])
+    groups = []                 # keys a stage sets to one value (equal at every point): one column
+    for k in points[0][0]:
+        same = next((g for g in groups if all(p[g[0]] == p[k] for p, _ in points)), None)
+        if same is None:
+            groups.append([k])
+        else:
+            same.append(k)
     responses = list(dict.fromkeys(r for _, rs in points for r in rs))
-    lines = ["| point | " + " | ".join(keys) + " | " + " | ".join(f"{r}: mean (SD; n)" for r in responses) + " |",
-             "|---" * (1 + len(keys) + len(responses)) + "|"]
+    lines = ["| point | " + " | ".join(" = ".join(g) for g in groups) + " | "
+             + " | ".join(f"{r}: mean (SD; n)" for r in responses) + " |",
+             "|---" * (1 + len(groups) + len(responses)) + "|"]
     for i, (params, rs) in enumerate(points, start=1):
-        cells = [_fmt(params[k]) for k in keys]
+        cells = [_fmt(params[g[0]]) for g in groups]
         cells += [f"{_fmt(rs[r][0])} ({_fmt(rs[r][1])}; {rs[r][2]})" if r in rs else "-" for r in responses]
         lines.append(f"| {i} | " + " | ".join(cells) + " |")
     return "\n".join(lines) + "\n"

@@ -21,7 +21,7 @@ def _history(path, rows):
 
 
 def test_a_point_asked_twice_in_a_row_is_two_points_and_other_stages_are_left_out(sp, tmp_path):
-    a, b = {"mu": 0.5, "eta": 0.2}, {"mu": 0.6, "eta": 0.2}
+    a, b = {"mu": 0.5, "eta": 0.2, "eta_wall": 0.2}, {"mu": 0.6, "eta": 0.2, "eta_wall": 0.2}
     _history(tmp_path / "history.csv", [
         ("M3-dry", "final", a, "aor_mean_deg", 38.0, 3.0, 2), ("M3-dry", "final", a, "surcharge_mean_deg", 25.0, 9.0, 2),
         ("M3-dry", "other", a, "aor_mean_deg", 99.0, 0.0, 2),
@@ -31,7 +31,9 @@ def test_a_point_asked_twice_in_a_row_is_two_points_and_other_stages_are_left_ou
     assert [p for p, _ in pts] == [a, a, b]
     assert pts[1][1]["aor_mean_deg"] == (40.0, 1.0, 2)
     md = sp.table(pts)
-    assert md.splitlines()[0] == "| point | mu | eta | aor_mean_deg: mean (SD; n) | surcharge_mean_deg: mean (SD; n) |"
+    # keys set to one value at every point share a column
+    assert md.splitlines()[0] == ("| point | mu | eta = eta_wall | aor_mean_deg: mean (SD; n) | "
+                                  "surcharge_mean_deg: mean (SD; n) |")
     assert "| 2 | 0.5 | 0.2 | 40 (1; 2) | - (-; 0) |" in md and "| 3 | 0.6 | 0.2 | 37 (2; 2) | - |" in md
 
 
