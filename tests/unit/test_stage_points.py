@@ -43,3 +43,20 @@ def test_a_folder_without_history_or_without_the_stage_is_refused_with_exit_2(sp
     _history(tmp_path / "history.csv", [("M2", "density", {"rho": 3000.0}, "bulk_density_kg_m3", 1600.0, 10.0, 2)])
     assert sp.main([str(tmp_path), "M3-dry", "final"]) == 2
     assert "no point of stage 'final'" in capsys.readouterr().err
+
+
+def test_the_linear_fit_recovers_known_slopes_per_parameter(sp, tmp_path):
+    """runs.csv of a stage whose response is exactly 10 + 20 mu + 60 eta: slopes 20 and 60, SD 0;
+    the wall key set to eta's value at every run is one parameter, not a second column."""
+    with open(tmp_path / "runs.csv", "w", newline="") as f:
+        w = csv.writer(f)
+        w.writerow(["material", "stage", "rig", "parameters", "seed", "response", "value"])
+        for i, (mu, eta) in enumerate([(0.2, 0.1), (0.5, 0.1), (0.3, 0.3), (0.6, 0.25), (0.4, 0.05)]):
+            p = json.dumps({"mu": mu, "eta": eta, "eta_wall": eta})
+            w.writerow(["M3-dry", "final", "surcharge", p, i + 1, "surcharge_mean_deg", 10 + 20 * mu + 60 * eta])
+            w.writerow(["M3-dry", "final", "surcharge", p, i + 1, "aor_mean_deg", "nan"])
+    fit = sp.linear_fit(tmp_path / "runs.csv", "M3-dry", "final")
+    keys, b, se, sd, n = fit["surcharge_mean_deg"]
+    assert keys == ["mu", "eta"] and n == 5
+    assert b == pytest.approx([20.0, 60.0]) and sd == pytest.approx(0.0, abs=1e-9)
+    assert "aor_mean_deg" not in fit                   # no run with a value
