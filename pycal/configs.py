@@ -19,6 +19,7 @@ from .errors import ConfigError
 UNIT_SUFFIXES = ("_m", "_m_s", "_m_s2", "_s", "_pa", "_n", "_kg", "_kg_m3", "_deg", "_deg_s",
                  "_hz", "_j", "_rad", "_rad_s")
 DIMENSIONLESS_SUFFIXES = ("_ratio", "_fraction", "_factor", "_coefficient", "_count", "_percent")
+DIMENSIONLESS_NAMES = ("scale",)      # whole key names that are a pure ratio (a rig's geometry.scale)
 
 
 def _rel(path):
@@ -231,7 +232,7 @@ def check_rig_keys(data, c, key=""):
             is_num = (isinstance(v, (int, float)) and not isinstance(v, bool)) or (
                 isinstance(v, list) and v and all(isinstance(x, (int, float)) for x in v))
             if is_num:
-                if not str(k).endswith(UNIT_SUFFIXES + DIMENSIONLESS_SUFFIXES):
+                if not str(k).endswith(UNIT_SUFFIXES + DIMENSIONLESS_SUFFIXES) and k not in DIMENSIONLESS_NAMES:
                     c.fail(sub, "numeric key needs a unit suffix (SI: "
                            + ", ".join(UNIT_SUFFIXES) + "; or dimensionless: "
                            + ", ".join(DIMENSIONLESS_SUFFIXES) + ")")

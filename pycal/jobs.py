@@ -21,6 +21,7 @@ from .configs import (SET_DIR, component_value, load_yaml, material_set_names, p
 from .contact_rules import ContactRuleError, check_job
 from .errors import ConfigError
 from . import rigs, step_estimate
+from .rigs import scaling
 
 JOB_FORMAT = 1
 
@@ -86,13 +87,14 @@ def resolve_job(rig, material, overrides=None, seed=1, config_dir=CONFIG_DIR):
     mat = copy.deepcopy(load_material(material, config_dir))
     for key, value in overrides.items():
         if key.startswith("rig."):
-            _set_path(rig_cfg, key[4:], value, f"overrides of configs/rigs/{rig}.yaml", rigs.get(rig).optional)
+            _set_path(rig_cfg, key[4:], value, f"overrides of configs/rigs/{rig}.yaml", rig_optional_keys(rig))
         else:
             _set_path(mat, key, value, f"overrides of configs/materials/{material}.yaml")
     partners = set(material_names(config_dir)) | set(load_boundaries_cached(config_dir))
     with blame_override(overrides, ""):
         validate_material(mat, f"configs/materials/{material}.yaml (with overrides)", partners)
     check_rig_with_overrides(rig, rig_cfg, overrides, config_dir)
+    rig_cfg = scale_rig(rig, rig_cfg, overrides)
     return _finish_job(rig, rig_cfg, seed, material, {material: mat}, overrides, config_dir)
 
 
@@ -151,12 +153,28 @@ def resolve_set_job(rig, set_name, overrides=None, seed=1, config_dir=CONFIG_DIR
     material_overrides = {}
     for key, value in overrides.items():
         if key.startswith("rig."):
-            _set_path(rig_cfg, key[4:], value, f"overrides of configs/rigs/{rig}.yaml", rigs.get(rig).optional)
+            _set_path(rig_cfg, key[4:], value, f"overrides of configs/rigs/{rig}.yaml", rig_optional_keys(rig))
         else:
             material_overrides[key] = value
     materials, mset = resolve_set_materials(set_name, material_overrides, config_dir)
     check_rig_with_overrides(rig, rig_cfg, overrides, config_dir)
+    rig_cfg = scale_rig(rig, rig_cfg, overrides)
     return _finish_job(rig, rig_cfg, seed, set_name, materials, overrides, config_dir, material_set=mset)
+
+
+def rig_optional_keys(rig):
+    """Dotted rig keys an override may add although the config leaves them out: the rig's
+    optional keys and geometry.scale (every rig's)."""
+    return tuple(rigs.get(rig).optional) + (f"geometry.{scaling.SCALE_KEY}",)
+
+
+def scale_rig(rig, rig_cfg, overrides):
+    """The rig config as built at its geometry.scale (pycal/rigs/scaling.py); a refusal
+    names '--set rig.geometry.scale=S' when an override set it, else the rig's config."""
+    key = f"rig.geometry.{scaling.SCALE_KEY}"
+    if key in overrides:
+        return scaling.apply_scale(rig, rig_cfg, "--set", f"{key}={overrides[key]!r}")
+    return scaling.apply_scale(rig, rig_cfg, f"configs/rigs/{rig}.yaml", f"geometry.{scaling.SCALE_KEY}")
 
 
 def _own_carried_key(raw, key, known):

@@ -111,6 +111,12 @@ def check(job):
     overrides = job.get("overrides") or {}
     keys = [k for k in overrides if k.endswith(DT_KEYS) or k == "rig.numerics.timestep_safety_factor"]
     keys += [k for k in overrides if k == longest[2]]
+    scale = job["rig_config"]["geometry"].get("scale", 1)
+    if scale != 1 and not keys:       # a scaled rig: its lengths drive the lift, pour and slides
+        why += f" (at geometry.scale {scale:g}: every length of the rig x {scale:g})"
+        if "rig.geometry.scale" in overrides:
+            raise ConfigError("--set", f"rig.geometry.scale={scale:g}", why)
+        raise ConfigError(f"configs/rigs/{job['rig']}.yaml", "geometry.scale", why)
     if keys:
         value = overrides[keys[0]]
         shown = f"{value:g}" if isinstance(value, (int, float)) and not isinstance(value, bool) else value

@@ -23,7 +23,7 @@ _REGISTRY = {}
 def _load():
     if not _REGISTRY:
         for info in pkgutil.iter_modules([str(Path(__file__).parent)]):
-            if info.name.startswith("_") or info.name in ("descriptor", "fields"):
+            if info.name.startswith("_") or info.name in ("descriptor", "fields", "scaling"):
                 continue
             module = importlib.import_module(f"{__name__}.{info.name}")
             desc = module.DESCRIPTOR
@@ -103,7 +103,7 @@ def check_config(data, file, boundaries, numerics_keys):
             if k not in known:
                 raise ConfigError(file, f"{section}.{k}", f"unknown key{nearest(k, known)} (known: {', '.join(known)})")
         for k in known:
-            if k not in got and f"{section}.{k}" not in desc.optional:
+            if k not in got and f"{section}.{k}" not in desc.optional and (section, k) != ("geometry", "scale"):
                 raise ConfigError(file, f"{section}.{k}", "missing")
         for k, v in got.items():
             why = check_value(k, v, boundaries)

@@ -34,10 +34,15 @@ class RigDescriptor:
     lab_curves: tuple = ()                          # rigs whose lab curves <rig>_<sample> it is compared with
     comparisons: tuple = ()                         # (misfit, result key, lab quantity, lab factor, branch)
     pictures: tuple = ()                            # pictures a run writes that the report shows (file names)
+    scale_refused: str = ""                         # why geometry.scale cannot be other than 1 ("": it can;
+                                                    # pycal/rigs/scaling.py)
 
     def keys(self, section):
+        """The keys a config's section may hold: required, optional, and geometry.scale
+        (every rig's, optional: pycal/rigs/scaling.py)."""
+        extra = ("scale",) if section == "geometry" else ()
         return tuple(getattr(self, section)) + tuple(k.split(".", 1)[1] for k in self.optional
-                                                       if k.startswith(section + "."))
+                                                       if k.startswith(section + ".")) + extra
 
     def required_result_keys(self):
         return SHARED_RESULT_KEYS + tuple(self.result_keys)

@@ -19,6 +19,8 @@ class Field:
     hi_open: bool = False      # hi itself refused
     choices: tuple = ()        # kind choice
     reason: str = ""           # why the range (shown with a refusal)
+    scales: str = ""           # under geometry.scale s (pycal/rigs/scaling.py): "length" x s, "area" x s^2
+                               # (a mass whose weight loads an area: its stress kept), "" kept as it is
 
 
 def positive(reason="must be > 0"):
@@ -38,31 +40,37 @@ def count(lo=1, reason=""):
 
 
 LENGTH = positive("a length")
+RIG_LENGTH = Field("number", 0.0, lo_open=True, reason="a length", scales="length")   # a length of the rig itself
+RIG_GAP = Field("number", 0.0, reason="must be >= 0", scales="length")              # a gap of the rig (may be 0)
 TIME = positive("a duration")
 SPEED = positive("a speed: 0 never ends")
 RATE = positive("a tilt rate: 0 never ends")
 MASS = positive("a mass")
+LOAD_MASS = Field("number", 0.0, lo_open=True, reason="a mass", scales="area")   # lid, ring: stress kept
 
 FIELDS = {
     # ------------------------------------------------------------- geometry
-    "cell_inner_diameter_m": LENGTH,
-    "cell_height_m": LENGTH,
+    "scale": Field("number", 1.0, reason="the rig's lengths x this (1: the lab's size); below 1 the rig holds fewer "
+                   "grains than the lab's own, which is what the scale is there to avoid"),
+    "cell_inner_diameter_m": RIG_LENGTH,
+    "cell_height_m": RIG_LENGTH,
     "cell_facet_segments_count": count(3, "a polygon needs >= 3 sides (the shipped cells use 32)"),
     "cell_material": Field("boundary"),
-    "cell_gap_m": positive("the gap between the two cells is the shear plane: > 0"),
-    "cell_gap_to_plate_m": non_negative(),
-    "cell_mass_kg": MASS,
-    "lid_mass_kg": MASS,
+    "cell_gap_m": Field("number", 0.0, lo_open=True, reason="the gap between the two cells is the shear plane: > 0",
+                        scales="length"),
+    "cell_gap_to_plate_m": RIG_GAP,
+    "cell_mass_kg": LOAD_MASS,
+    "lid_mass_kg": LOAD_MASS,
     "lid_material": Field("boundary"),
     "table_material": Field("boundary"),
-    "table_half_width_m": LENGTH,
-    "table_radius_m": LENGTH,
+    "table_half_width_m": RIG_LENGTH,
+    "table_radius_m": RIG_LENGTH,
     "plate_material": Field("boundary"),
-    "plate_diameter_m": LENGTH,
+    "plate_diameter_m": RIG_LENGTH,
     "plate_length_m": LENGTH,
-    "plate_half_width_m": LENGTH,
-    "plate_front_length_m": LENGTH,
-    "plate_back_length_m": non_negative(),
+    "plate_half_width_m": RIG_LENGTH,
+    "plate_front_length_m": RIG_LENGTH,
+    "plate_back_length_m": RIG_GAP,
     "plate_inclination_deg": Field("number", 0.0, 90.0, hi_open=True, reason="a plate between flat and vertical"),
     "impact_point_from_plate_top_m": non_negative(),
     "stream_width_m": LENGTH,
@@ -77,14 +85,14 @@ FIELDS = {
     "fill_solid_fraction": Field("number", 0.0, 0.74, lo_open=True, reason="a solid fraction (0.74: densest "
                                  "sphere packing)"),
     "fill_overfill_ratio": Field("number", 1.0, reason="the column holds at least the cell's volume"),
-    "strike_level_height_m": LENGTH,
+    "strike_level_height_m": RIG_LENGTH,
     "lift_speed_m_s": SPEED,
-    "lift_clearance_m": non_negative(),
+    "lift_clearance_m": RIG_GAP,
     "load_steps_pa": Field("stress_list", reason="stresses > 0"),
     "unload_steps_pa": Field("stress_list", reason="stresses > 0"),
     "consolidation_stresses_pa": Field("stress_list", reason="stresses > 0"),
     "plate_speed_max_m_s": SPEED,
-    "plate_start_gap_m": non_negative(),
+    "plate_start_gap_m": RIG_GAP,
     "step_tolerance_ratio": fraction("a relative tolerance on a load step"),
     "servo_relaxation_time_s": TIME,
     "servo_control_interval_s": TIME,

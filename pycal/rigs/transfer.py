@@ -24,4 +24,6 @@ DESCRIPTOR = RigDescriptor(
     measure=("steady_from_s", "plug_outflow_ratio", "record_interval_s", "force_sample_interval_count",
              "speed_gauge_height_m", "stress_profile_bin_m", "frame_interval_s"),
     phases=phases, result_keys=("impact_stress_pa", "throughput_in_kg_s", "throughput_out_kg_s"),
-    accepts_material_sets=True, check_job=check_job, post="transfer")
+    accepts_material_sets=True, check_job=check_job, post="transfer",
+    scale_refused="the transfer rig is the design chute at its own size (the plate, the stream and the drop of the "
+                  "design case), not a lab rig to hold more grains")
