@@ -119,6 +119,17 @@ CAMPAIGNS = {
         (("steel friction", "steel0.3", "steel0.5", "interactions.steel.friction_coefficient"),),
         "the study's wall stage: 12 / 40 / 90 kPa, E 1e8 Pa, M2 start values otherwise"),
 }
+WET_COHESION = {"model": "hysteretic", "force_fraction": 0.5, "pressure_fraction": 0.0896, "update_interval_s": 0.01}
+CAMPAIGNS["internal_M3-wet"] = Campaign(
+    "internal_friction", "M3-wet",
+    {"rig.procedure.consolidation_stresses_pa": [12000, 40000, 90000], "rig.procedure.pre_tilt_rate_deg_s": 20.0,
+     "rig.procedure.tilt_rate_deg_s": 5.0, "rig.procedure.pre_tilt_slide_fraction": 0.5,
+     "rig.procedure.tilt_restart_rate_deg_s": 12.0, **E_CALIBRATED, **friction("M3-wet", 0.374),
+     **rolling("M3-wet", 0.19), "interactions.M3-wet.cohesion": WET_COHESION},
+    {"calibrated": {}}, ("friction_angle_offset_deg", "mean_mu_static", "n_particles"), (),
+    "the wet cohesion stage's settings (12 / 40 / 90 kPa, holds after the onset) at e8de67a's calibrated wet "
+    "values: hysteretic cohesion pressure_fraction 0.0896 with weight part 0.5, friction 0.374, rolling 0.19, "
+    "E 1e8 Pa; the cohesion law is per contact of the same 25 mm spheres at every scale, so it is not rescaled")
 CAMPAIGNS["fill_M3-dry"] = Campaign("fill", "M3-dry", {}, {"start": {}}, CAMPAIGNS["fill_M2"].responses, (),
                                     "M3-dry start values (density 2750)")
 

@@ -91,3 +91,14 @@ def test_a_scene_over_the_step_limit_is_refused_naming_the_scale():
     """At 2 mm/s a cylinder 20x the lab's lifts for ~1000 s of simulated time."""
     with pytest.raises(ConfigError, match=r"geometry.scale"):
         resolve_job("aor", "M2", {"rig.geometry.scale": 20, "rig.numerics.max_estimated_steps_count": 1e7})
+
+
+def test_docs_name_every_key_the_scale_changes():
+    """docs/rigs.md "Geometric scale" lists each key that pycal/rigs/fields.py scales."""
+    from pycal import REPO_ROOT
+    from pycal.rigs.fields import FIELDS
+    text = (REPO_ROOT / "docs" / "rigs.md").read_text()
+    section = text.split("### Geometric scale", 1)[1].split("\n### ", 1)[0]
+    for key, f in FIELDS.items():
+        if f.scales:
+            assert f"`{key}`" in section, key
