@@ -117,6 +117,11 @@ def _cmd_impact(args):
     cli_impact(args)
 
 
+def _cmd_results(args):
+    from .results_page import main as results_main
+    results_main(args.study, args.wall_time_s, args.update_readme)
+
+
 def build_parser():
     from .executors import DEFAULT_RUNS_DIR, add_executor_args
     from .arguments import OneLineParser
@@ -183,6 +188,14 @@ def build_parser():
     s.add_argument("--flow-t-h", type=float, required=True)
     s.add_argument("--bulk-density-kg-m3", type=float, required=True)
     s.set_defaults(func=_cmd_impact)
+
+    s = sub.add_parser("results", help="docs/results/<study>.json from a finished study run (the README's results "
+                                       "tables); --update-readme rewrites the README's generated block")
+    s.add_argument("study", help="the study's output folder, e.g. runs/study/zinc_ore")
+    s.add_argument("--wall-time-s", type=float, default=None,
+                   help="wall time of the whole run, measured around the command (default: the study's own)")
+    s.add_argument("--update-readme", action="store_true", help="replace the README's generated results block")
+    s.set_defaults(func=_cmd_results)
 
     from . import extra_commands
     extra_commands.register(sub)
