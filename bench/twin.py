@@ -181,6 +181,25 @@ def simulate_targets(executor, hidden, seeds, lab):
     return out
 
 
+def final_pass_stage(density, rolling):
+    """A joint pass over rolling resistance and density, from the shipped study's two stages
+    (their rigs, overrides, bounds and tolerances): the twin's last stage, both values again."""
+    roll = rolling["parameter"]
+    dens = density["parameter"]
+    aor = {"rig": rolling["rig"], "response": rolling["response"], "target": dict(rolling["target"])}
+    if rolling.get("rig_overrides"):
+        aor["rig_overrides"] = dict(rolling["rig_overrides"])
+    fill = {"rig": density["rig"], "response": "bulk_density_kg_m3", "target": dict(density["target"])}
+    if density.get("rig_overrides"):
+        fill["rig_overrides"] = dict(density["rig_overrides"])
+    return {"stage": "joint", "name": "rolling_density_final", "responses": [aor, fill],
+            "parameters": [{"keys": list(roll["keys"]), "bounds": list(roll["bounds"]),
+                            "tolerance_coefficient": roll["tolerance_coefficient"]},
+                           {"keys": ["particles.density_kg_m3"], "bounds": list(dens["bounds"]), "scale": "log",
+                            "tolerance_kg_m3": dens["tolerance_kg_m3"]}],
+            "max_runs_count": 48}
+
+
 def twin_study(name, hidden, targets, seeds_count, final_pass=True, target_seeds_count=3):
     """The study config (a dict) of one twin: the shipped M2 stages for the hidden
     parameters, targets set to the twin's (with their standard errors, each estimated
@@ -203,7 +222,7 @@ def twin_study(name, hidden, targets, seeds_count, final_pass=True, target_seeds
             st["target"] = {"value": 0.0, f"standard_error_{unit}": round(float(se), 6), **n, **band}
         stages.append(st)
     if final_pass and {"particle_density_kg_m3", "rolling_resistance_coefficient"} <= set(hidden):
-        st = json.loads(json.dumps(by_label["rolling_density_final"]))
+        st = final_pass_stage(by_label["density"], by_label["rolling_resistance"])
         for r in st["responses"]:
             value, se = targets[r["response"]]
             unit = responses.get(r["response"]).unit

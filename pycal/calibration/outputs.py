@@ -85,7 +85,24 @@ def calibration_record(study, material):
             kept[k] = {"start_value": start, "note": "not calibrated: start value of the config"}
     return {"material": material, "study": study.cfg["name"], "study_config": str(study.config_path),
             "started_utc": prov.get("started_utc"), "git_commit": prov.get("git_commit"),
-            "git_dirty": prov.get("git_dirty"), "calibrated": calibrated, "start_values": kept}
+            "git_dirty": prov.get("git_dirty"), "calibrated": calibrated, "start_values": kept,
+            "rig_scales": stage_rig_scales(study.cfg["materials"][material]),
+            "rig_scales_note": "each stage's rig at its geometric scale (geometry.scale, 1 = the lab's size; "
+                               "docs/rigs.md): the values hold for a bulk of that many grains, not for the lab's cell"}
+
+
+def stage_rig_scales(stages):
+    """{stage label: {rig: geometry.scale}} of the stages that run a rig (the rig config's
+    scale, or the stage's rig.geometry.scale override)."""
+    from ..configs import load_rig
+    out = {}
+    for st in stages:
+        specs = st.get("responses") or ([st] if st.get("rig") else [])
+        for spec in specs:
+            over = spec.get("rig_overrides") or st.get("rig_overrides") or {}
+            scale = over.get("rig.geometry.scale", load_rig(spec["rig"])["geometry"].get("scale", 1))
+            out.setdefault(st["label"], {})[spec["rig"]] = float(scale)
+    return out
 
 
 def _plain(v):

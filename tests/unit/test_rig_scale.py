@@ -66,9 +66,11 @@ def test_scale_1_is_the_lab_job():
     """A config that says scale 1 builds the job of a config that says nothing (same id)."""
     from pycal.rigs.scaling import apply_scale
     from pycal.configs import load_rig
-    cfg = load_rig("fill")
+    cfg = load_rig("fill")                     # the shipped fill says scale 2
+    plain = dict(cfg, geometry={k: v for k, v in cfg["geometry"].items() if k != "scale"})
     cfg_1 = dict(cfg, geometry=dict(cfg["geometry"], scale=1))
-    assert apply_scale("fill", cfg_1, "f", "k") == apply_scale("fill", cfg, "f", "k") == cfg
+    assert apply_scale("fill", cfg_1, "f", "k") == apply_scale("fill", plain, "f", "k") == plain
+    assert apply_scale("fill", cfg, "f", "k")["geometry"]["cell_inner_diameter_m"] == 2 * plain["geometry"]["cell_inner_diameter_m"]
 
 
 def test_every_rig_but_the_transfer_scales_a_length():

@@ -318,18 +318,23 @@ def test_shipped_study_config_is_valid():
     cfg = load_study(DEFAULT_STUDY)
     assert set(cfg["materials"]) == {"M2", "M3-dry", "M3-wet"}
     kinds = {(m, st["label"]): st["kind"] for m, sts in cfg["materials"].items() for st in sts}
-    # the method's stages that were missing: wet cohesion from the wet internal-friction curve,
-    # and a final pass over rolling resistance and density after the friction stages
+    # the wet cohesion from the wet internal-friction curve
     wet = next(st for st in cfg["materials"]["M3-wet"] if st["label"] == "cohesion")
     assert wet["rig"] == "internal_friction" and wet["response"] == "friction_angle_offset_deg"
-    for m, final in (("M2", "rolling_density_final"), ("M3-dry", "friction_rolling_density_final")):
+    # the dry materials: rolling resistance on the (scaled) AoR, the density checked again last, at the
+    # calibrated stiffness and friction; no stage moves the held particle friction of the fines
+    for m in ("M2", "M3-dry"):
         labels = [st["label"] for st in cfg["materials"][m]]
-        assert labels[-1] == final and kinds[(m, labels[-1])] == "joint"
-        assert labels.index("wall_friction") < labels.index(final)
-    # the dry fines' final pass reads the surcharge run's pile before and after the vibration
-    dry = cfg["materials"]["M3-dry"][-1]
-    assert [(r["rig"], r["response"]) for r in dry["responses"]] == [
-        ("surcharge", "aor_mean_deg"), ("surcharge", "surcharge_mean_deg"), ("fill", "bulk_density_kg_m3")]
+        assert labels[-1] == "density_recheck" and kinds[(m, labels[-1])] == "density"
+        assert labels.index("wall_friction") < labels.index("density_recheck")
+        roll = next(st for st in cfg["materials"][m] if st["label"] == "rolling_resistance")
+        assert roll["rig"] == "aor"
+    for m, sts in cfg["materials"].items():
+        for st in sts:
+            keys = [k for p in st.get("parameters", [st.get("parameter") or {}]) for k in p.get("keys", [])]
+            keys += st.get("keys", [])
+            assert "interactions.M3-dry.friction_coefficient" not in keys, (m, st["label"])
+            assert "interactions.M3-wet.friction_coefficient" not in keys, (m, st["label"])
 
 
 @pytest.fixture
@@ -755,6 +760,7 @@ def test_calibrated_files_say_which_values_were_calibrated_with_intervals_and_wh
     assert rr["stage"] == "M3-dry/rolling_resistance" and rr["start_value"] == 0.35
     assert rr["interval_95"][0] <= rr["value"] <= rr["interval_95"][1]
     assert rec["git_commit"] and rec["started_utc"]
+    assert rec["rig_scales"]["rolling_resistance"] == {"aor": 1.5}     # the shipped cylinder (configs/rigs/aor.yaml)
     wet = yaml.safe_load((study.out / "calibrated" / "M3-wet.calibration.yaml").read_text())
     assert "interactions.M3-wet.cohesion.force_fraction" in wet["start_values"]
     assert wet["calibrated"]["interactions.M3-wet.rolling_resistance_coefficient"]["stage"] == "M3-wet/inherit"

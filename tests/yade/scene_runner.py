@@ -11,9 +11,12 @@ from pycal.runner import yade_env
 SCENES = Path(__file__).resolve().parent / "scenes"
 
 
+LAB_SIZE = {"rig.geometry.scale": 1}   # the rig at the lab's size (the shipped fill, AoR and surcharge are scaled)
+
+
 def scene_job(overrides=None, material="M2", rig="fill"):
-    """A library job (the rig's config, the material's values) for a scene."""
-    return resolve_job(rig, material, overrides or {}, seed=1)
+    """A library job (the rig's config at the lab's size, the material's values) for a scene."""
+    return resolve_job(rig, material, dict(LAB_SIZE, **(overrides or {})), seed=1)
 
 
 def add_material(job, name, like, pairs):

@@ -9,7 +9,7 @@ import pytest
 from pycal.errors import RunError
 from pycal.jobs import resolve_job
 from pycal.runner import run_job, job_dir
-from scene_runner import run_scene, scene_job
+from scene_runner import LAB_SIZE, run_scene, scene_job
 
 from documented import assert_documented
 
@@ -23,7 +23,7 @@ OLD = {"rig.numerics.contact_model": "linear_cundall"}
 @pytest.fixture(scope="module")
 def fill_pair(tmp_path_factory):
     """The same fill job (M2 start values, seed 1) run twice in two fresh run dirs."""
-    job = resolve_job("fill", "M2", seed=1)
+    job = resolve_job("fill", "M2", LAB_SIZE, seed=1)
     a = run_job(job, tmp_path_factory.mktemp("runs_a"))
     b = run_job(job, tmp_path_factory.mktemp("runs_b"))
     return job, a, b
@@ -64,7 +64,7 @@ def test_blow_up_is_detected_and_leaves_no_result(tmp_path):
     1e4 Pa before a run (pycal/plausible.py), so the job is edited after resolution: the
     guard inside the rig is what is tested."""
     from pycal.jobs import job_id
-    job = resolve_job("fill", "M2", seed=1)
+    job = resolve_job("fill", "M2", LAB_SIZE, seed=1)
     job["materials"]["M2"]["contact"]["youngs_modulus_pa"] = 1.0e4
     job["job_id"] = job_id(job)
     with pytest.raises(RunError, match="blow-up"):

@@ -35,7 +35,7 @@ SEEDS = (1, 2)
 
 
 def fill_jobs():
-    return [resolve_job("fill", "M2", seed=s) for s in SEEDS]
+    return [resolve_job("fill", "M2", {"rig.geometry.scale": 1}, seed=s) for s in SEEDS]   # the lab's cell
 
 
 def measurements(result):
@@ -238,7 +238,7 @@ def test_yade_batch_cpu_limit_is_reported_per_job(tmp_path):
 
 def test_batch_table_run_by_hand_then_pycal_run_is_all_cached(tmp_path, capsys, reference):
     runs, table = tmp_path / "runs", tmp_path / "fill.table"
-    args = ["fill", "--material", "M2", "--seeds", "2", "--out", str(runs)]
+    args = ["fill", "--material", "M2", "--seeds", "2", "--out", str(runs), "--set", "rig.geometry.scale=1"]
     assert main(["batch-table"] + args + ["--table", str(table), "--workers", "2"]) == 0
     printed = capsys.readouterr().out
     line = next(l.strip() for l in printed.splitlines() if "yade-batch " in l)

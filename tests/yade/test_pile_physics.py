@@ -15,7 +15,8 @@ pytestmark = pytest.mark.yade
 
 MATERIAL = "M2"
 SEED = 3
-FAST = {"rig.procedure.lift_speed_m_s": 0.05,      # 25 x the lab speed: a ~2 s lift
+FAST = {"rig.geometry.scale": 1,                   # the lab's cylinder
+        "rig.procedure.lift_speed_m_s": 0.05,      # 25 x the lab speed: a ~2 s lift
         "rig.procedure.pour_height_factor": 1.6}   # just enough pour to fill to the rim
 # Bounds from measurements (seed 3, this fast scene, 64 particles):
 # - frictionless spheres spread into a flat monolayer: no sector had an angle (the old

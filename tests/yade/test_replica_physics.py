@@ -22,7 +22,7 @@ from scene_runner import run_scene, scene_job
 
 pytestmark = pytest.mark.yade
 
-SHORT = {"rig.procedure.pour_height_factor": 1.6}
+SHORT = {"rig.procedure.pour_height_factor": 1.6, "rig.geometry.scale": 1}   # the lab's cell
 FILL_KEYS = ("bulk_density_kg_m3", "n_particles", "mass_kg", "settle_time_s", "steps")
 
 

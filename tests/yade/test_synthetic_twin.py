@@ -24,7 +24,7 @@ TRUTH_KG_M3 = 3600.0
 
 def test_density_twin_recovers_hidden_value(tmp_path):
     pool = LocalPool(tmp_path / "runs", workers=2, progress=False)
-    hidden = pool.run([resolve_job("fill", "M2", {"particles.density_kg_m3": TRUTH_KG_M3}, seed=s)
+    hidden = pool.run([resolve_job("fill", "M2", {"particles.density_kg_m3": TRUTH_KG_M3, "rig.geometry.scale": 1}, seed=s)
                        for s in (101, 102)])
     target, sd = mean_std([r["bulk_density_kg_m3"] for r in hidden])
     se = sd / 2 ** 0.5                     # the target is itself a mean of 2 fills
@@ -36,6 +36,7 @@ materials:
   M2:
     - stage: density
       rig: fill
+      rig_overrides: {{rig.geometry.scale: 1}}
       target: {{value: {target}, standard_error_kg_m3: {se}}}
       parameter: {{bounds: [1500.0, 9000.0], tolerance_kg_m3: 150.0}}
       max_runs_count: 10
