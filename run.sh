@@ -54,6 +54,9 @@ case "$cmd" in
   test)
     ensure_deps
     export OMP_NUM_THREADS=1
+    # scipy's L-BFGS-B (Fortran) prints "ascent direction in projection" unasked; unbuffered, it goes out while
+    # pytest captures the test's output, instead of after pytest's summary line at exit (numbers unchanged)
+    export GFORTRAN_UNBUFFERED_PRECONNECTED=y
     exec "$PY" -m pytest -q -p no:cacheprovider tests "$@" ;;
   pycal)
     ensure_deps
