@@ -96,13 +96,29 @@ def record(study_dir, wall_time_s=None):
             "wall_time_source": "measured around the whole command" if wall_time_s is not None
             else "the study's own elapsed time", "cpu_time_s": cpu, "runs_count": runs,
             "rig_scales": scales, "stages": _stage_rows(summary),
-            "validation": _validation_rows(summary), "application": _application_rows(summary)}
+            "validation": _validation_rows(summary), "application": _application_rows(summary),
+            **_progress(summary)}
+
+
+def _progress(summary):
+    """{'stages_planned', 'stages_done', 'finished'}: how far the run got (a study's summary
+    is written after every stage, so a run stopped midway has a partial one)."""
+    study = summary.get("study") or {}
+    planned = sum(len(sts) for sts in (study.get("materials") or {}).values())
+    done = len(summary.get("stages") or [])
+    tail_wanted = bool((study.get("validation") or {}).get("predictions")) or bool(
+        (study.get("application") or {}).get("runs"))
+    tail_done = bool(summary.get("predicted")) or bool(summary.get("applied"))
+    return {"stages_planned": planned, "stages_done": done,
+            "finished": done >= planned and (tail_done or not tail_wanted)}
 
 
 def _num(v, digits=3):
     if not _finite(v):
         return "-"
-    return f"{v:.{digits}g}" if abs(v) < 1e5 else f"{v:.{digits}e}"
+    if abs(v) >= 1e5:
+        return f"{v:.{digits}e}"
+    return f"{v:.0f}" if abs(v) >= 10 ** (digits - 1) else f"{v:.{digits}g}"   # 3367, not 3.37e+03
 
 
 def _yes(v):
@@ -121,7 +137,11 @@ def render(rec):
              f"{' (uncommitted changes)' if rec.get('git_dirty') else ''}, started {rec.get('started_utc') or '?'}, "
              f"seed base {rec.get('seed_base')}; {_num(minutes)} min wall ({rec['wall_time_source']}), "
              f"{_num(rec['cpu_time_s'] / 3600)} CPU hours over {rec['runs_count']} runs; "
-             f"{stages_met} of {stages_all} calibrated stages precise enough. Rig scales: {scales}.", "",
+             f"{stages_met} of {stages_all} calibrated stages precise enough. Rig scales: {scales}.", ""]
+    if not rec.get("finished", True):
+        lines += [f"**A partial run**: recorded after {rec['stages_done']} of {rec['stages_planned']} stages (the "
+                  "stages below); the later stages, the validation and the application had not run.", ""]
+    lines += [
              "| material | stage | parameter | estimate [95 % interval] | tolerance | matches the lab | precise enough "
              "| runs |", "|---|---|---|---|---|---|---|---|"]
     for s in rec["stages"]:
