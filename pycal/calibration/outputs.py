@@ -95,12 +95,13 @@ def stage_rig_scales(stages):
     """{stage label: {rig: geometry.scale}} of the stages that run a rig (the rig config's
     scale, or the stage's rig.geometry.scale override)."""
     from ..configs import load_rig
+    from ..rigs.scaling import SCALE_KEY, scale_of
     out = {}
     for st in stages:
         specs = st.get("responses") or ([st] if st.get("rig") else [])
         for spec in specs:
             over = spec.get("rig_overrides") or st.get("rig_overrides") or {}
-            scale = over.get("rig.geometry.scale", load_rig(spec["rig"])["geometry"].get("scale", 1))
+            scale = over.get(f"rig.geometry.{SCALE_KEY}", scale_of(load_rig(spec["rig"])))
             out.setdefault(st["label"], {})[spec["rig"]] = float(scale)
     return out
 
