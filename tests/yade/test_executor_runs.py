@@ -27,6 +27,7 @@ from pycal.executors.local import LocalPool
 from pycal.executors.yade_batch import YadeBatch, write_batch_table
 from pycal.executors.yade_process import yade_env
 from pycal.jobs import job_id, resolve_job
+from scene_runner import LAB_SIZE
 
 pytestmark = [pytest.mark.yade,
               pytest.mark.skipif(shutil.which("yade") is None, reason="yade is not installed")]
@@ -35,7 +36,7 @@ SEEDS = (1, 2)
 
 
 def fill_jobs():
-    return [resolve_job("fill", "M2", {"rig.geometry.scale": 1}, seed=s) for s in SEEDS]   # the lab's cell
+    return [resolve_job("fill", "M2", LAB_SIZE, seed=s) for s in SEEDS]
 
 
 def measurements(result):

@@ -7,6 +7,7 @@ folder and the assertions read its result.json.
 import pytest
 
 from pycal.jobs import resolve_job
+from scene_runner import LAB_SIZE
 from pycal.runner import run_job
 
 from documented import assert_documented
@@ -15,7 +16,7 @@ pytestmark = pytest.mark.yade
 
 MATERIAL = "M2"
 SEED = 3
-FAST = {"rig.geometry.scale": 1,                   # the lab's cylinder
+FAST = {**LAB_SIZE,                                # the lab's cylinder
         "rig.procedure.lift_speed_m_s": 0.05,      # 25 x the lab speed: a ~2 s lift
         "rig.procedure.pour_height_factor": 1.6}   # just enough pour to fill to the rim
 # Bounds from measurements (seed 3, this fast scene, 64 particles):

@@ -18,11 +18,11 @@ from pycal.jobs import resolve_job
 from pycal.runner import run_job
 
 from documented import assert_documented
-from scene_runner import run_scene, scene_job
+from scene_runner import LAB_SIZE, run_scene, scene_job
 
 pytestmark = pytest.mark.yade
 
-SHORT = {"rig.procedure.pour_height_factor": 1.6, "rig.geometry.scale": 1}   # the lab's cell
+SHORT = {"rig.procedure.pour_height_factor": 1.6, **LAB_SIZE}
 FILL_KEYS = ("bulk_density_kg_m3", "n_particles", "mass_kg", "settle_time_s", "steps")
 
 

@@ -14,6 +14,7 @@ from pycal.jobs import resolve_job
 from pycal.runner import run_job
 from pycal.vtk_output import with_vtk
 
+from scene_runner import LAB_SIZE
 from vtk_files import vtu_header
 
 pytestmark = pytest.mark.yade
@@ -23,7 +24,7 @@ INTERVAL_S = 0.25
 
 def test_fill_snapshots_hold_the_struck_cell(tmp_path_factory):
     runs = tmp_path_factory.mktemp("vtk_fill")
-    plain = resolve_job("fill", "M2", {"rig.geometry.scale": 1}, seed=2)
+    plain = resolve_job("fill", "M2", LAB_SIZE, seed=2)
     job = with_vtk(plain, INTERVAL_S)
     assert job["job_id"] != plain["job_id"] and {k: v for k, v in job.items() if k not in ("vtk", "job_id")} == \
         {k: v for k, v in plain.items() if k != "job_id"}
