@@ -164,3 +164,33 @@ def random_rotation(rng):
         [2 * (x * z - y * w), 2 * (y * z + x * w), 1 - 2 * (x * x + y * y)],
     ])
     return R, (w, x, y, z)
+
+
+# ---------------------------------------------------------------- radii of a job's particles
+
+def _clump_member_radius(mat, class_names=None):
+    """Smallest member-sphere radius (m) of a clump material over its size classes (the
+    ones named, or all) and the shapes they use."""
+    p = mat["particles"]
+    radii = []
+    for sc in p["size_classes"]:
+        if class_names is not None and sc["name"] not in class_names:
+            continue
+        for shape, pct in sc["shape_percent"].items():
+            if pct > 0:
+                s = p["shapes"][shape]
+                radii.append(member_radius(box_dims(s["vertical_aspect_ratio"], s["horizontal_aspect_ratio"],
+                                                    sc["min_size_m"])))
+    return min(radii)
+
+
+def particle_radii(job):
+    """{material: smallest particle-sphere radius (m)} of the job's materials."""
+    classes = {name: c.get("size_classes") for name, c in job.get("material_set", {}).get("components", {}).items()}
+    out = {}
+    for name, mat in job["materials"].items():
+        if mat["particles"]["shape"] == "clump":
+            out[name] = _clump_member_radius(mat, classes.get(name))
+        else:
+            out[name] = 0.5 * mat["particles"]["diameter_m"]
+    return out

@@ -21,40 +21,12 @@ line naming the values that drive the estimate (pycal.jobs.resolve_job).
 import math
 
 from .errors import ConfigError
+from .lump_geometry import particle_radii
 
 DT_KEYS = ("contact.youngs_modulus_pa", "particles.density_kg_m3", "particles.diameter_m")
 
 
 # ---------------------------------------------------------------- time step
-
-def _clump_member_radius(mat, class_names=None):
-    """Smallest member-sphere radius (m) of a clump material over its size classes (the
-    ones named, or all) and the shapes they use."""
-    from .lump_geometry import box_dims, member_radius
-    p = mat["particles"]
-    radii = []
-    for sc in p["size_classes"]:
-        if class_names is not None and sc["name"] not in class_names:
-            continue
-        for shape, pct in sc["shape_percent"].items():
-            if pct > 0:
-                s = p["shapes"][shape]
-                radii.append(member_radius(box_dims(s["vertical_aspect_ratio"], s["horizontal_aspect_ratio"],
-                                                    sc["min_size_m"])))
-    return min(radii)
-
-
-def particle_radii(job):
-    """{material: smallest particle-sphere radius (m)} of the job's materials."""
-    classes = {name: c.get("size_classes") for name, c in job.get("material_set", {}).get("components", {}).items()}
-    out = {}
-    for name, mat in job["materials"].items():
-        if mat["particles"]["shape"] == "clump":
-            out[name] = _clump_member_radius(mat, classes.get(name))
-        else:
-            out[name] = 0.5 * mat["particles"]["diameter_m"]
-    return out
-
 
 def critical_timestep(job):
     """(time step s, material that sets it, its radius m): safety factor x the smallest

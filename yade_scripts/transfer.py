@@ -3,7 +3,7 @@ and runs off (docs/rigs.md, transfer; configs/rigs/transfer.yaml).
 
 A slice of the stream, `slice_width_m` wide, between periodic boundaries across the stream
 (y). The stream is injected through a horizontal window just above the plate with the
-velocity and bulk density it has there after its fall from the belt (pycal.stream,
+velocity and bulk density it has there after its fall from the belt (pycal.rigs.transfer.stream,
 demlib.feeder), for `feed_time_s`; the scene then runs `holdup_wait_s` more. Particles whose
 centre passes the plate's lower end have run off, those that fall back past its top end (upstream of
 it and below it) have spilled upstream: both are
@@ -50,7 +50,7 @@ class Plate:
         from yade import O, utils, Vector3
         self.geo = geo
         top, t, L = geo["plate_top_m"], geo["plate_tangent"], geo["plate_length_m"]
-        from pycal.stream import PLATE_HALF_WIDTH_M
+        from pycal.rigs.transfer.stream import PLATE_HALF_WIDTH_M
         W, Y = geo["slice_width_m"], PLATE_HALF_WIDTH_M
         apex = Vector3(top[0] + 2.0 * L * t[0], 0.5 * W, top[1] + 2.0 * L * t[1])
         a = Vector3(top[0], -Y, top[1])
@@ -114,7 +114,7 @@ class Transfer:
 
     def __init__(self, scene):
         from yade import O
-        from pycal import stream
+        from pycal.rigs.transfer import stream
         from pycal.step_estimate import critical_timestep
         job = scene.job
         self.job = job

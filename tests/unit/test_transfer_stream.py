@@ -1,4 +1,4 @@
-"""pycal.stream: the transfer rig's stream and plate from the job alone (no YADE), with
+"""pycal.rigs.transfer.stream: the transfer rig's stream and plate from the job alone (no YADE), with
 answers computed by hand, and the refusal of geometries that cannot work (one line naming
 the key of configs/rigs/transfer.yaml, exit 2, nothing written).
 
@@ -16,7 +16,7 @@ import math
 
 import pytest
 
-from pycal import stream
+from pycal.rigs.transfer import stream
 from pycal.cli import main
 from pycal.configs import load_yaml
 from pycal import CONFIG_DIR
@@ -103,7 +103,7 @@ def test_bad_geometry_is_refused_in_one_line(tmp_path, capsys, over, key, why):
     assert main(args) == 2
     err = capsys.readouterr().err.strip()
     # a single key out of its range: the --set that put it there (pycal/rigs/fields.py); a
-    # value the stream cannot run: the rig config's key (pycal.stream)
+    # value the stream cannot run: the rig config's key (pycal.rigs.transfer.stream)
     assert len(err.splitlines()) == 1, err
     assert err.startswith((f"error: configs/rigs/transfer.yaml: {key}: ", f"error: --set: rig.{key}=")), err
     assert why in err, err

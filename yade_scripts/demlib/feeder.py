@@ -1,7 +1,7 @@
 """A falling stream fed through a horizontal window, layer by layer (transfer rig; the planning
 and placement functions are pure Python and run anywhere, Feeder runs inside YADE).
 
-The feed time is split into N equal intervals dt (pycal.stream.layer_times). At the start of
+The feed time is split into N equal intervals dt (pycal.rigs.transfer.stream.layer_times). At the start of
 interval k one layer of particles is created just above the injection window: its mass is
 what the stream carries through the window in dt (the slice's mass flow x dt), split over
 the job's components by their mass fractions; each particle gets the stream's velocity at

@@ -25,7 +25,7 @@ free flight) come within R of the plate, projected onto the plate ([s_a, s_b]).
 
 Two reference stresses (neither depends on the DEM):
 - design_impact_stress_pa: the method's formula, P = rho0 v0 vz (only the vertical velocity,
-  the stream meeting a horizontal surface; pycal.lab_analysis.impact_stress);
+  the stream meeting a horizontal surface; pycal.impact_formula.impact_stress);
 - momentum_flux_stress_pa: the stream's normal momentum flux over its footprint on this
   plate, rho_b u_n^2 with u_n = vz cos a - v0 sin a the velocity component normal to the plate
   (= the design value for a = 0), i.e. the design formula rho_b v^2 sin^2(theta) with the
@@ -33,8 +33,9 @@ Two reference stresses (neither depends on the DEM):
 """
 import math
 
-from .errors import ConfigError
-from .lab_analysis import impact_stress, min_drop_height_m
+from ...errors import ConfigError
+from ...impact_formula import impact_stress, min_drop_height_m
+from ...lump_geometry import bounding_radius, particle_radii, shape_members
 
 RIG_FILE = "configs/rigs/transfer.yaml"
 CELL_MARGIN_M = 3.0          # periodic cell size in x and z: the rig's extent plus this (no image ever meets)
@@ -77,8 +78,7 @@ def to_plate(top, t, n, x, z):
 
 def contact_radius_m(job):
     """R (m): the radius of the job's sphere materials (the smallest, if they differ); a job of
-    lumps only: the smallest lump member (pycal.step_estimate.particle_radii)."""
-    from .step_estimate import particle_radii
+    lumps only: the smallest lump member (pycal.lump_geometry.particle_radii)."""
     spheres = [0.5 * m["particles"]["diameter_m"] for m in job["materials"].values()
                if m["particles"]["shape"] == "sphere"]
     return min(spheres) if spheres else min(particle_radii(job).values())
@@ -87,7 +87,6 @@ def contact_radius_m(job):
 def largest_bounding_radius_m(job):
     """Radius (m) of the largest particle's bounding sphere: a sphere's radius, a lump's
     bounding sphere at its class's largest size (pycal/lump_geometry.py)."""
-    from .lump_geometry import bounding_radius, shape_members
     comps = job.get("material_set", {}).get("components", {})
     out = 0.0
     for name, mat in job["materials"].items():

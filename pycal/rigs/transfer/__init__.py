@@ -1,6 +1,7 @@
 """transfer: a belt stream on an inclined steel plate (application: impact stress,
-holdup, plugging). No fill and no replicas (a periodic cell)."""
-from .descriptor import RigDescriptor
+holdup, plugging). No fill and no replicas (a periodic cell). The stream's geometry: stream.py."""
+from ..descriptor import RigDescriptor
+from . import stream
 
 
 def phases(job, wait, settle_key):
@@ -10,7 +11,6 @@ def phases(job, wait, settle_key):
 
 
 def check_job(job):
-    from .. import stream
     stream.check_job(job)
 
 
