@@ -12,7 +12,6 @@ fewer seeds a stage needs; seeds needed for a +-0.05 interval ~ (1.96 x precisio
 0.05)^2). The reading is chosen on the first --choose-seeds seeds and checked on the rest.
 """
 import argparse
-import json
 import math
 import statistics
 import sys
@@ -23,7 +22,7 @@ import numpy as np
 sys.path.insert(0, str(Path(__file__).resolve().parent.parent))
 from pycal.post.aor import read_positions_csv  # noqa: E402
 from pycal.post.aor_readings import READINGS  # noqa: E402
-from pycal.replicas import expand  # noqa: E402
+from pycal.runs_index import ok_results  # noqa: E402
 from pycal.files import write_text  # noqa: E402
 
 ETA_KEY = "interactions.M2.rolling_resistance_coefficient"
@@ -32,16 +31,11 @@ ETA_KEY = "interactions.M2.rolling_resistance_coefficient"
 def load(runs_dir, eta_key=ETA_KEY):
     """{(eta, seed): {reading: angle}} over the aor runs of RUNS_DIR."""
     out = {}
-    for res in sorted(Path(runs_dir, "aor").glob("*/result.json")):
-        r = json.loads(res.read_text())
-        runs = ([(seed, one) for seed, one, _ in expand(r) if one is not None] if "replicas" in r
-                else [(r["seed"], r)])
-        for seed, one in runs:
-            folder = res.parent / one["provenance"]["replica_dir"] if "replicas" in r else res.parent
-            eta = one["job"]["overrides"].get(eta_key)
-            m = one["job"]["rig_config"]["measure"]
-            pos = read_positions_csv(folder / "pile_particles.csv")
-            out[(eta, seed)] = {name: f(pos, m) for name, f in READINGS.items()}
+    for row, one in ok_results(runs_dir, "aor"):
+        eta = one["job"]["overrides"].get(eta_key)
+        m = one["job"]["rig_config"]["measure"]
+        pos = read_positions_csv(Path(row["folder"]) / "pile_particles.csv")
+        out[(eta, one["seed"])] = {name: f(pos, m) for name, f in READINGS.items()}
     return out
 
 

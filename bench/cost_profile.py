@@ -4,7 +4,8 @@ and per phase of the rigs.
     /usr/bin/python3 bench/cost_profile.py STUDY_DIR [--runs RUNS_DIR] [--out profile.md]
 
 STUDY_DIR is a study's output folder (runs/study/zinc_ore): its jobs.csv lists every job
-the study asked (section, rig, seed, job id, batch job id). Each job's folder in RUNS_DIR
+the study asked (section, rig, seed, job id, batch job id); the runs are read through
+pycal.runs_index (`pycal runs RUNS_DIR --study STUDY_DIR`). Each job's folder in RUNS_DIR
 (default: the study folder's grandparent, i.e. runs/) holds its result.json, whose
 provenance gives the process's CPU time (cpu_time_s), wall time, simulated time, time
 steps and the CPU time and steps per phase (phase_cpu: pour, strike, consolidate,
@@ -24,22 +25,22 @@ from pathlib import Path
 
 sys.path.insert(0, str(Path(__file__).resolve().parent.parent))
 from pycal.files import write_text  # noqa: E402
+from pycal.runs_index import runs_table  # noqa: E402
 
 
 def load(study_dir, runs_dir):
-    """[(row of jobs.csv, result or None, share of the folder's cost)], one per distinct job."""
-    rows, seen = [], set()
-    with open(Path(study_dir) / "jobs.csv") as f:
-        jobs = list(csv.DictReader(f))
-    for j in jobs:
-        if j["job_id"] in seen:
+    """[(run {'section', 'rig'}, result.json or None, share of the folder's cost)], one per distinct
+    job the study asked for (pycal.runs_index; a run two sections asked for counts in the first)."""
+    df = runs_table(runs_dir, study_dir)
+    rows = []
+    for r in df[df["stage"] != ""].to_dict("records"):
+        run = {"section": r["stage"].split(";")[0], "rig": r["rig"]}
+        if r["status"] != "ok":
+            rows.append((run, None, 1.0))
             continue
-        seen.add(j["job_id"])
-        folder = j.get("batch_job_id") or j["job_id"]
-        path = Path(runs_dir) / j["rig"] / folder / "result.json"
-        result = json.loads(path.read_text()) if path.is_file() and j["status"] == "ok" else None
-        share = 1.0 / max(1, len(result["replicas"])) if result is not None and "replicas" in result else 1.0
-        rows.append((j, result, share))
+        folder = Path(r["folder"]).parent if r["batch_job_id"] else Path(r["folder"])
+        result = json.loads((folder / "result.json").read_text())
+        rows.append((run, result, 1.0 / max(1, len(result.get("replicas") or [None]))))
     return rows
 
 

@@ -27,6 +27,7 @@ import yaml
 
 sys.path.insert(0, str(Path(__file__).resolve().parent.parent))
 from pycal.files import write_text  # noqa: E402
+from pycal.runs_index import ok_results  # noqa: E402
 
 MIN_STRESS_PA = 10000.0
 
@@ -40,11 +41,7 @@ def parse_value(text):
 
 
 def load_runs(runs_dir, rig):
-    out = []
-    for path in sorted((Path(runs_dir) / rig).glob("*/result.json")):
-        r = json.loads(path.read_text())
-        out.append(r)
-    return out
+    return [r for _, r in ok_results(runs_dir, rig)]
 
 
 def key_of(overrides, parameter):

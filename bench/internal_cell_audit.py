@@ -49,6 +49,7 @@ from friction_equivalence import fmt, mean_sd_se, step_values  # noqa: E402
 from pycal.calibration.study_config import load_study  # noqa: E402
 from pycal.files import write_text  # noqa: E402
 from pycal.post.friction import friction_offset  # noqa: E402
+from pycal.runs_index import ok_results  # noqa: E402
 
 STUDY = ROOT / "configs" / "calibrations" / "zinc_ore.yaml"
 STAGE_SETTINGS = {                 # the dry fines' internal-friction stage as it last ran (af07e0c)
@@ -117,10 +118,7 @@ def suspect_of(overrides, material):
 def load(runs, material):
     """{(suspect, friction, rolling): [result]} of the audit's runs in RUNS_DIR."""
     out = {}
-    for path in sorted((Path(runs) / "internal_friction").glob("*/result.json")):
-        r = json.loads(path.read_text())
-        if r.get("material") != material:
-            continue
+    for _, r in ok_results(runs, "internal_friction", material):
         key = suspect_of(r["job"].get("overrides") or {}, material)
         if key:
             out.setdefault(key, []).append(r)

@@ -37,6 +37,7 @@ from pycal.configs import load_numerics, load_rig  # noqa: E402
 from pycal.export.conversions import liggghts_rolling_coefficient  # noqa: E402
 from pycal.export.formats import export, load_calibrated  # noqa: E402
 from pycal.post import aor as aor_post  # noqa: E402
+from pycal.runs_index import ok_results  # noqa: E402
 
 LIFT_SPEED_M_S = 0.01       # the calibration's AoR stages (configs/calibrations/zinc_ore.yaml)
 
@@ -179,8 +180,7 @@ def run_yade(study, material, rig_name, seeds, out):
     subprocess.run(cmd, cwd=REPO, check=True, capture_output=True, text=True)
     key = "aor_mean_deg" if rig_name == "aor" else "bulk_density_kg_m3"
     vals = []
-    for f in sorted((Path(out) / rig_name).glob(f"{rig_name}-{material}-s*/result.json")):
-        r = json.loads(f.read_text())
+    for _, r in ok_results(out, rig_name, material):
         if r["job"]["seed"] <= seeds and r.get(key) is not None:
             vals.append(r[key])
     return vals

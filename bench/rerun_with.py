@@ -4,7 +4,7 @@ measured on exactly the runs a stage made).
     /usr/bin/python3 bench/rerun_with.py RUNS_DIR --rig internal_friction --material M3-wet \
         --set rig.procedure.tilt_rate_deg_s=5.0 --out runs/bench_wet_tilt [--seeds 1-9]
 
-Every job of RUNS_DIR/<rig>/<rig>-<material>-s<seed>-*/job.json (every seed there) is rebuilt from its
+Every lone job of the rig and material in RUNS_DIR (pycal.runs_index; every seed there) is rebuilt from its
 recorded overrides (the rebuilt job id must equal the recorded one: the same job), run
 again with the --set overrides added, and compared: per run the stage responses
 --response (default `friction_angle_offset_deg`: a stage response of pycal.post.responses, a
@@ -25,6 +25,7 @@ import yaml
 sys.path.insert(0, str(Path(__file__).resolve().parent.parent))
 from pycal.executors.local import LocalPool  # noqa: E402
 from pycal.jobs import resolve_job  # noqa: E402
+from pycal.runs_index import job_files  # noqa: E402
 
 
 def rebuilt(job_file, extra):
@@ -82,7 +83,7 @@ def main(argv=None):
     ap.add_argument("--seeds", default=None, help="only these seeds: FIRST-LAST or a comma list (default: every seed)")
     args = ap.parse_args(argv)
     extra = {k: yaml.safe_load(v) for k, v in (s.split("=", 1) for s in args.set)}
-    files = sorted(Path(args.runs, args.rig).glob(f"{args.rig}-{args.material}-s*/job.json"))
+    files = job_files(args.runs, args.rig, args.material)
     if args.seeds:
         wanted = seed_list(args.seeds)
         files = [f for f in files if json.loads(f.read_text())["seed"] in wanted]

@@ -36,6 +36,7 @@ from pycal.configs import load_numerics  # noqa: E402
 from pycal.files import write_text  # noqa: E402
 from pycal.post.aor import read_positions_csv  # noqa: E402
 from pycal.post.aor_readings import READINGS  # noqa: E402
+from pycal.runs_index import ok_results  # noqa: E402
 
 OTHER_READINGS = ("sector_median", "rotated_sector_mean", "cone")
 
@@ -93,23 +94,19 @@ def load(runs, material):
     per seed (a job's replica: its measurements, its seed, and the job's CPU seconds shared out over its replicas)."""
     out = {}
     rolling_key = rolling_keys(material)[0]
-    for path in sorted((Path(runs) / "surcharge").glob("*/result.json")):
-        r = json.loads(path.read_text())
-        ov = (r.get("job") or {}).get("overrides") or {}
-        if r.get("material") != material or ov.get("rig.procedure.lift_speed_m_s") != LIFT_SPEED_M_S:
+    for row, r in ok_results(runs, "surcharge", material):
+        ov = r["job"].get("overrides") or {}
+        if ov.get("rig.procedure.lift_speed_m_s") != LIFT_SPEED_M_S or not row["batch_job_id"]:
             continue
         fr = ov.get(f"interactions.{material}.friction_coefficient")
         rr = ov.get(rolling_key)
         vib = rig_vibration(r["job"]["rig_config"]["procedure"])
         if fr is None or rr is None:
             continue
-        reps = r.get("replicas") or []
-        cpu = r["provenance"]["cpu_time_s"] / max(1, len(reps))
-        for rep in reps:
-            if rep.get("status") == "ok":
-                seed = {**rep["measurements"], "seed": rep["seed"], "cpu_time_s": cpu,
-                        "measure": r["job"]["rig_config"]["measure"], "folder": path.parent / rep["output_dir"]}
-                out.setdefault((fr, rr, vib), []).append(seed)
+        seed = {**{k: v for k, v in r.items() if k not in ("job", "provenance")}, "seed": row["seed"],
+                "cpu_time_s": row["cpu_time_s"], "measure": r["job"]["rig_config"]["measure"],
+                "folder": Path(row["folder"])}
+        out.setdefault((fr, rr, vib), []).append(seed)
     return out
 
 

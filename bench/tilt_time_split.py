@@ -23,6 +23,8 @@ from pathlib import Path
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 from rerun_with import seed_list  # noqa: E402
+sys.path.insert(0, str(Path(__file__).resolve().parent.parent))
+from pycal.runs_index import job_files  # noqa: E402
 
 
 def step_traces(job_dir):
@@ -69,10 +71,9 @@ def main(argv=None):
     tot = {"static": 0.0, "hold": 0.0, "restart": 0.0}
     saved = {f: 0.0 for f in fractions}
     cpu, jobs, steps = {}, 0, 0
-    for job_dir in sorted(Path(a.runs, a.rig).glob(f"{a.rig}-{a.material}-s*")):
-        if not (job_dir / "result.json").exists():
-            continue
-        job = json.loads((job_dir / "job.json").read_text())
+    for job_file in job_files(a.runs, a.rig, a.material, status="ok"):
+        job_dir = job_file.parent
+        job = json.loads(job_file.read_text())
         if wanted is not None and job["seed"] not in wanted:
             continue
         result = json.loads((job_dir / "result.json").read_text())

@@ -23,6 +23,7 @@ from rerun_with import rebuilt  # noqa: E402
 from pycal.executors.jobdirs import cached_result  # noqa: E402
 from pycal.executors.local import LocalPool  # noqa: E402
 from pycal.files import write_text  # noqa: E402
+from pycal.runs_index import job_files  # noqa: E402
 
 SETS = {"mixed-dry": "M3-dry", "mixed-wet": "M3-wet"}   # the set and its fines
 GRAVEL = "M2"
@@ -71,7 +72,7 @@ VARIANTS = {
 
 def jobs_of(runs, material_set):
     """The study's transfer jobs of a set (job.json files), by seed."""
-    files = sorted(Path(runs, "transfer").glob(f"transfer-{material_set}-s*/job.json"))
+    files = job_files(runs, "transfer", material_set)
     if not files:
         raise SystemExit(f"{runs}/transfer: no transfer job of {material_set} (a main job's runs folder?)")
     return files

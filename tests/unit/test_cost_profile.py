@@ -7,13 +7,20 @@ from bench_scripts import load_bench_script
 cost = load_bench_script("cost_profile")
 
 
-def write_result(runs, rig, folder, cpu, phases=None, replicas=None):
+def write_result(runs, rig, folder, cpu, phases=None, replicas=None, seed=1):
+    """A result.json as a rig writes it (a batch's: one entry per replica)."""
     d = runs / rig / folder
     d.mkdir(parents=True)
-    r = {"provenance": {"cpu_time_s": cpu, "wall_time_s": cpu * 2, "steps_count": 1000,
+    job = {"job_id": folder, "rig": rig, "material": "M2", "overrides": {}}
+    job.update({"seeds": replicas} if replicas else {"seed": seed})
+    r = {"job_id": folder, "rig": rig, "material": "M2", "job": job, "contact_model": "hertz_mindlin",
+         "provenance": {"cpu_time_s": cpu, "wall_time_s": cpu * 2, "steps_count": 1000,
                         "simulated_time_s": 1.0, "phase_cpu": phases}}
     if replicas:
-        r["replicas"] = [{"seed": s} for s in replicas]
+        r["replicas"] = [{"seed": s, "status": "ok", "measurements": {}, "simulated_time_s": 1.0, "steps_count": 500}
+                         for s in replicas]
+    else:
+        r["seed"] = seed
     (d / "result.json").write_text(json.dumps(r))
 
 

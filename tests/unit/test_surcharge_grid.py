@@ -17,12 +17,24 @@ def fake_run(folder, friction, rolling, seed, aor, surcharge, heights=(0.08, 0.0
     m = {"aor_mean_deg": aor, "surcharge_mean_deg": surcharge, "surcharge_left_deg": surcharge,
          "surcharge_right_deg": None, "pile_height_m": heights[0],
          "surcharge_pile_height_m": heights[1]}
-    r = {"material": material, "seeds": [seed], "job": {"overrides": ov, "rig_config": rig(amplitude_mm)},
-         "replicas": [{"seed": seed, "status": "ok", "measurements": m, "output_dir": f"s{seed}"}],
-         "provenance": {"cpu_time_s": 20.0 + seed}}
-    d = folder / "surcharge" / f"job-{friction}-{rolling}-{seed}-{lift}-{amplitude_mm}"
+    name = f"job-{friction}-{rolling}-{seed}-{lift}-{amplitude_mm}"
+    r = batch_result(name, material, [seed], ov, rig(amplitude_mm), [replica(seed, m)], 20.0 + seed)
+    d = folder / "surcharge" / name
     d.mkdir(parents=True)
     (d / "result.json").write_text(json.dumps(r))
+
+
+def replica(seed, measurements, status="ok"):
+    return {"seed": seed, "status": status, "measurements": measurements, "output_dir": f"s{seed}",
+            "simulated_time_s": 10.0, "steps_count": 1000, "failure": None if status == "ok" else "no rest"}
+
+
+def batch_result(name, material, seeds, overrides, rig_config, replicas, cpu):
+    """A batch job's result.json as the rig writes it."""
+    job = {"job_id": name, "rig": "surcharge", "material": material, "seeds": seeds, "overrides": overrides,
+           "rig_config": rig_config}
+    return {"job_id": name, "rig": "surcharge", "material": material, "seeds": seeds, "job": job,
+            "contact_model": "hertz_mindlin", "replicas": replicas, "provenance": {"cpu_time_s": cpu}}
 
 
 MEASURE = yaml.safe_load((grid.ROOT / "configs" / "rigs" / "surcharge.yaml").read_text())["measure"]
@@ -71,12 +83,9 @@ def test_grid_points_are_found_from_their_overrides_and_tabulated(tmp_path):
     fake_run(tmp_path, 0.8, 0.05, 2, 44.0, 28.0, lift=0.002)   # another lift speed: not a grid run
     fake_run(tmp_path, 0.8, 0.05, 3, 30.0, 10.0, material="M2")
     fake_run(tmp_path, 0.8, 0.05, 4, 44.0, 35.0, amplitude_mm=0.5)   # another vibration: its own grid point
-    two = {"material": "M3-dry", "seeds": [5, 6],
-           "job": {"overrides": grid.settings("M3-dry", 0.3, 0.4), "rig_config": rig(0.125)},
-           "replicas": [{"seed": 5, "status": "ok", "output_dir": "s5",
-                         "measurements": {"aor_mean_deg": 30.0, "pile_height_m": 0.07, "surcharge_pile_height_m": 0.03}},
-                        {"seed": 6, "status": "failed", "measurements": {}, "output_dir": "s6"}],
-           "provenance": {"cpu_time_s": 50.0}}                      # two seeds in one job, one failed
+    two = batch_result("two", "M3-dry", [5, 6], grid.settings("M3-dry", 0.3, 0.4), rig(0.125),
+                       [replica(5, {"aor_mean_deg": 30.0, "pile_height_m": 0.07, "surcharge_pile_height_m": 0.03}),
+                        replica(6, {}, "failed")], 50.0)              # two seeds in one job, one failed
     (tmp_path / "surcharge" / "two").mkdir()
     (tmp_path / "surcharge" / "two" / "result.json").write_text(json.dumps(two))
     groups = grid.load(tmp_path, "M3-dry")
