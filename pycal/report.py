@@ -14,6 +14,7 @@ import math
 from pathlib import Path
 
 from .calibration.names import fmt3, format_params, unit_label
+from .calibration.stages import calibrates
 from .calibration.study import cost_per_material
 from .files import write_text
 
@@ -51,13 +52,13 @@ def _img(study_dir, rel):
 
 def headline(stages):
     """'3 of 5 calibrated stages met ...' and the stages not met (inherited values apart)."""
-    calibrated = [s for s in stages if s["kind"] != "inherit"]
+    calibrated = [s for s in stages if calibrates(s["kind"])]
     met = [s for s in calibrated if s["met"]]
     lab = [s for s in calibrated if s.get("matches_lab")]
     text = (f"{len(met)} of {len(calibrated)} calibrated stages are precise enough (the whole 95 % interval "
             f"within ± tolerance of the estimate); {len(lab)} match the lab (the fitted response at the "
             f"estimate within the lab band).")
-    inherited = [s for s in stages if s["kind"] == "inherit"]
+    inherited = [s for s in stages if not calibrates(s["kind"])]
     if inherited:
         text += f" {len(inherited)} value{'s' if len(inherited) > 1 else ''} inherited from other materials."
     return text, [s for s in calibrated if not s["met"]]
@@ -318,7 +319,7 @@ def write_report(study_dir):
         parts.append(f"<tr><td>{_esc(mat)}</td><td class=num>{c['runs_requested']}</td>"
                      f"<td class=num>{c['runs_simulated']}</td><td class=num>{c['elapsed_s']:.0f}</td></tr>")
     parts.append("</table><h2>Stages</h2>")
-    parts += [_stage_detail(study_dir, s, summary.get("history") or []) for s in stages if s["kind"] != "inherit"]
+    parts += [_stage_detail(study_dir, s, summary.get("history") or []) for s in stages if calibrates(s["kind"])]
     parts += _run_at_checks(summary.get("run_at_checks") or [])
     parts += _validation(study_dir, summary.get("predicted") or [])
     parts += _application(study_dir, summary.get("applied") or [])

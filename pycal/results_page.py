@@ -15,6 +15,7 @@ import math
 from pathlib import Path
 
 from . import REPO_ROOT
+from .calibration.stages import calibrates
 from .errors import ConfigError
 from .files import write_json, write_text
 
@@ -128,7 +129,7 @@ def _yes(v):
 def render(rec):
     """The README block (markdown) of one record."""
     minutes = rec["wall_time_s"] / 60 if _finite(rec.get("wall_time_s")) else math.nan
-    met = [s for s in rec["stages"] if s["kind"] != "inherit"]
+    met = [s for s in rec["stages"] if calibrates(s["kind"])]
     stages_met = len({(s["material"], s["stage"]) for s in met if s["precise_enough"]})
     stages_all = len({(s["material"], s["stage"]) for s in met})
     scales = "; ".join(f"{r} {' and '.join(f'{x:g}' for x in s)}" for r, s in rec["rig_scales"].items()) or "-"
@@ -146,15 +147,15 @@ def render(rec):
              "| runs |", "|---|---|---|---|---|---|---|---|"]
     for s in rec["stages"]:
         unit = f" {s['unit']}" if s["unit"] and s["unit"] not in ("-", "coefficient", "fraction") else ""
-        if s["kind"] == "inherit":
+        if not calibrates(s["kind"]):
             est = f"{_num(s['estimate'])}{unit} (inherited)"
         else:
             est = f"{_num(s['estimate'])} [{_num(s['low'])}, {_num(s['high'])}]{unit}"
         tol = f"+-{_num(s['tolerance'])}" if _finite(s.get("tolerance")) else "-"
-        precise = "-" if s["kind"] == "inherit" else (
+        precise = "-" if not calibrates(s["kind"]) else (
             "**yes**" if s["precise_enough"] else f"no ({s['stop_reason']})")
         lines.append(f"| {s['material']} | {s['stage']} | {s['parameter']} | {est} | {tol} | "
-                     f"{'-' if s['kind'] == 'inherit' else _yes(s['matches_lab'])} | {precise} | "
+                     f"{'-' if not calibrates(s['kind']) else _yes(s['matches_lab'])} | {precise} | "
                      f"{s['runs'] if s['runs'] is not None else '-'} |")
     if rec["validation"]:
         lines += ["", "| prediction (nothing fitted) | response | predicted: seed mean +- SD (n) | lab +- band | inside |",

@@ -72,7 +72,7 @@ def run(study):
         row = {"name": spec["name"], "rig": spec["rig"], "material": spec["material"], "responses": [],
                "seeds": [], "error": None, "plot": None}
         try:
-            results = study._run_seeds(spec["rig"], spec["material"], extra, seeds)
+            results = study.run_seeds(spec["rig"], spec["material"], extra, seeds)
         except RunError as exc:
             row["error"] = str(exc)
             rows.append(row)

@@ -35,6 +35,7 @@ def _study(args):
 
 def _cmd_calibrate(args):
     from ..report import write_report
+    from .stages import calibrates
     from .study import cost_per_material
     study, runs = _study(args)
     t0 = time.time()
@@ -43,7 +44,7 @@ def _cmd_calibrate(args):
           f"  runs cached in {runs}; interrupt at any time and run again to resume")
     rows = study.run()
     report = write_report(study.out)
-    calibrated = [r for r in rows if r["kind"] != "inherit"]
+    calibrated = [r for r in rows if calibrates(r["kind"])]
     print(f"\n{sum(r['met'] for r in calibrated)} of {len(calibrated)} calibrated stages met their tolerance "
           f"({time.time() - t0:.0f} s, {study.runs_requested} runs requested, cached ones not re-simulated):")
     for r in rows:

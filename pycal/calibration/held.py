@@ -5,10 +5,8 @@ material config's start value), and the stage's rig overrides. Shown in the repo
 
 
 def stage_keys(st):
-    """Material keys the stage fits (1-D `parameter`, joint `parameters`, inherited `keys`)."""
-    params = st.get("parameters") or ([st["parameter"]] if st.get("parameter") else [])
-    keys = [k for p in params for k in p["keys"]]
-    return keys + list(st.get("keys") or [])
+    """Material keys the stage fits or copies (its `parameter_keys`, in order)."""
+    return [k for keys in st["parameter_keys"] for k in keys]
 
 
 def held_values(study, material, st):
@@ -38,9 +36,8 @@ def held_values(study, material, st):
             if m != material:
                 out += [{"key": f"{m}.{k}", "value": v, "source": f"calibrated: {study.value_source[m].get(k, '?')}"}
                         for k, v in study.overrides.get(m, {}).items()]
-    for k, v in (st.get("rig_overrides") or {}).items():
-        out.append({"key": k, "value": v, "source": "rig override of this stage"})
-    for r in st.get("responses") or []:
+    for r in st["responses"]:
         for k, v in (r.get("rig_overrides") or {}).items():
-            out.append({"key": k, "value": v, "source": f"rig override ({r['rig']})"})
+            where = "of this stage" if st.get("rig") else f"({r['rig']})"    # a one-rig stage, or which rig
+            out.append({"key": k, "value": v, "source": f"rig override {where}"})
     return out

@@ -20,6 +20,7 @@ import yaml
 from .. import REPO_ROOT
 from ..files import finite, write_csv, write_json, write_text
 from ..gitinfo import git_commit
+from .stages import calibrates
 
 STAGE_COLUMNS = ["material", "stage", "kind", "parameter", "parameter_unit", "keys", "estimate", "interval_low",
                  "interval_high", "tolerance", "met", "stop_reason", "runs_requested", "runs_simulated",
@@ -98,9 +99,8 @@ def stage_rig_scales(stages):
     from ..rigs.scaling import SCALE_KEY, scale_of
     out = {}
     for st in stages:
-        specs = st.get("responses") or ([st] if st.get("rig") else [])
-        for spec in specs:
-            over = spec.get("rig_overrides") or st.get("rig_overrides") or {}
+        for spec in st["responses"]:                      # none for a stage that runs no rig
+            over = spec.get("rig_overrides") or {}
             scale = over.get(f"rig.geometry.{SCALE_KEY}", scale_of(load_rig(spec["rig"])))
             out.setdefault(st["label"], {})[spec["rig"]] = float(scale)
     return out
@@ -131,7 +131,7 @@ def write_all(study):
                # what the calibration fitted ("calibrated on") and what it predicts with those values
                "calibrated_on": [{"material": r["material"], "stage": r["stage"], "kind": r["kind"],
                                   "responses": [x.get("response") for x in r.get("responses", [])]}
-                                 for r in study.stage_rows if r["kind"] != "inherit"],
+                                 for r in study.stage_rows if calibrates(r["kind"])],
                "predicted": getattr(study, "validation_rows", []),
                "run_at_checks": getattr(study, "run_at_check_rows", []),
                "applied": getattr(study, "application_rows", []),

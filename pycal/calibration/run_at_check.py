@@ -40,9 +40,7 @@ def run(study):
         for st in stages:
             if not st.get("run_at") or (material, st["label"]) not in rows_by_label:
                 continue
-            specs = st["responses"] if st["kind"] == "joint" else [
-                {"rig": st["rig"], "response": st["response"], "rig_overrides": st["rig_overrides"]}]
-            for k, spec in enumerate(specs):
+            for k, spec in enumerate(st["responses"]):
                 todo.append((material, st, spec, rows_by_label[(material, st["label"])], k))
     if not todo:
         return []

@@ -45,9 +45,7 @@ def factors(study, pred, extra):
     groups = []                     # (component prefix, key list) of every stage parameter
     for material, stages in study.cfg["materials"].items():
         for st in stages:
-            lists = ([st["keys"]] if st["kind"] == "inherit" else
-                     [p["keys"] for p in st.get("parameters", [])] + ([st["parameter"]["keys"]] if "parameter" in st else []))
-            groups += [(material, tuple(keys)) for keys in lists if len(keys) > 1]
+            groups += [(material, tuple(keys)) for keys in st["parameter_keys"] if len(keys) > 1]
     out, placed = [], {}
     for key, value in extra.items():
         if key.startswith("rig.") or not movable(value):
@@ -96,7 +94,7 @@ def run_screening(study, pred, extra, facs, step, seeds, cmp):
                 over = moved(over, f, step)
         study.log(f"  design run {i + 1}/{len(design)}: high " +
                   (", ".join(f["label"].split(" (")[0] for f, lev in zip(facs, levels) if lev > 0) or "none"))
-        res = study._run_seeds(pred["rig"], pred["material"], over, seeds)
+        res = study.run_seeds(pred["rig"], pred["material"], over, seeds)
         y = response_of(res, cmp)
         if math.isnan(y):
             raise RunError(f"design run {i + 1}: no value of {cmp['response']} on seeds {study.last_seeds}")
@@ -111,12 +109,12 @@ def run_screening(study, pred, extra, facs, step, seeds, cmp):
 
 def run_one_at_a_time(study, pred, extra, facs, step, seeds, cmp):
     """Each factor alone at its high level, paired by seed with the calibrated runs."""
-    base = study._run_seeds(pred["rig"], pred["material"], extra, seeds)
+    base = study.run_seeds(pred["rig"], pred["material"], extra, seeds)
     base_by_seed = dict(zip(study.last_seeds, base))
     rows = []
     for f in facs:
         try:
-            res = study._run_seeds(pred["rig"], pred["material"], moved(extra, f, step), seeds)
+            res = study.run_seeds(pred["rig"], pred["material"], moved(extra, f, step), seeds)
         except RunError as exc:
             rows.append(dict(f, moved_to=f["value"] * (1 + step), effect=None, effect_se=None, error=str(exc)))
             continue

@@ -36,8 +36,8 @@ def _slope_per_u(st, scale, x0, y0):
     """d response / d u at the start (u: the parameter on [0, 1]) when physics gives it, signed."""
     p = st["parameter"]
     span = (math.log(scale.hi) - math.log(scale.lo)) if scale.log else (scale.hi - scale.lo)
-    if st["kind"] == "density":
-        slope = y0 * span if scale.log else y0 / x0 * span      # bulk density proportional to particle density
+    if st["response_proportional"]:                         # e.g. bulk density proportional to particle density
+        slope = y0 * span if scale.log else y0 / x0 * span
     elif p.get("slope"):
         slope = p["slope"] * (x0 * span if scale.log else span)
     else:
@@ -57,59 +57,61 @@ def decide_step(p, scale, xs, ys, target, runs_left, runs_per_point, lo_u=0.0, h
                    out_of_reach_factor=out_of_reach_factor)
 
 
-def run(study, material, st):
-    """Run the stage; returns its row (parameters, responses, met, stop reason, plots)."""
-    p = st["parameter"]
-    label = st["label"]
-    study.overrides[material].update(st["set"])
-    target = study.targets[(material, label)][0]
-    response = responses_mod.get(st["response"])
-    scale = Scale(*p["bounds"], log=p["scale"] == "log")
-    lab_dir = study.lab_dir(st)
-    n = len(study.seeds)
-    runs_at_start = study.runs_requested
-    xs, ys, refused = [], [], []
-    lo_u, hi_u = 0.0, 1.0
+class _Walk:
+    """The points of one stage so far (xs, ys per run), the points the rig refused and the
+    part [lo_u, hi_u] of the bounds in use (on the unit scale): what `run` decides from."""
 
-    def runs_left():
-        return min(st["max_runs_count"] - (study.runs_requested - runs_at_start), study.runs_left())
+    def __init__(self, study, material, st):
+        self.study, self.material, self.st = study, material, st
+        self.p = st["parameter"]
+        self.target = study.targets[(material, st["label"])][0]
+        self.response = responses_mod.get(st["response"])
+        self.scale = Scale(*self.p["bounds"], log=self.p["scale"] == "log")
+        self.lab_dir = study.lab_dir(st)
+        self.n = len(study.seeds)
+        self.runs_at_start = study.runs_requested
+        self.xs, self.ys, self.refused = [], [], []
+        self.lo_u, self.hi_u = 0.0, 1.0
+        self.jr = study.stage_journal(material, st)
 
-    def extra(x):
-        return {**st["rig_overrides"], **st["run_at"], **{k: x for k in p["keys"]}}
+    def runs_left(self):
+        return min(self.st["max_runs_count"] - (self.study.runs_requested - self.runs_at_start), self.study.runs_left())
 
-    jr = study.stage_journal(material, st)
+    def extra(self, x):
+        return {**self.st["rig_overrides"], **self.st["run_at"], **{k: x for k in self.p["keys"]}}
 
-    def point(x, replay=False):
+    def point(self, x, replay=False):
         """Run x; False when the rig refused it (then the bounds in use shrink)."""
-        nonlocal lo_u, hi_u
         x = round_significant(x)
         if not replay:
-            jr.record(x)
+            self.jr.record(x)
         try:
-            vals = study.run_point(material, label, st["rig"], extra(x), response, lab_dir)
+            vals = self.study.run_point(self.material, self.st["label"], self.st["rig"], self.extra(x), self.response,
+                                        self.lab_dir)
         except RunError as exc:
-            if not xs:
+            if not self.xs:
                 raise                      # the start point itself: the stage cannot run
-            u, ran = float(scale.to_unit(x)), scale.to_unit(np.array(xs))
-            refused.append((x, str(exc)))
-            study.log(f"  the rig refused {p['label']} = {x:.4g}: it becomes a limit")
+            u, ran = float(self.scale.to_unit(x)), self.scale.to_unit(np.array(self.xs))
+            self.refused.append((x, str(exc)))
+            self.study.log(f"  the rig refused {self.p['label']} = {x:.4g}: it becomes a limit")
             if u > np.median(ran):
-                hi_u = min(hi_u, 0.5 * (u + float(np.max(ran[ran < u], initial=0.0))))
+                self.hi_u = min(self.hi_u, 0.5 * (u + float(np.max(ran[ran < u], initial=0.0))))
             else:
-                lo_u = max(lo_u, 0.5 * (u + float(np.min(ran[ran > u], initial=1.0))))
+                self.lo_u = max(self.lo_u, 0.5 * (u + float(np.min(ran[ran > u], initial=1.0))))
             return False
-        xs.extend([x] * len(vals))
-        ys.extend(vals)
-        u = float(scale.to_unit(x))
-        lo_u, hi_u = min(lo_u, u), max(hi_u, u)     # a probe past a limit ran: the limit moves out to it
+        self.xs.extend([x] * len(vals))
+        self.ys.extend(vals)
+        u = float(self.scale.to_unit(x))
+        self.lo_u, self.hi_u = min(self.lo_u, u), max(self.hi_u, u)   # a probe past a limit ran: the limit moves out
         return True
 
-    def probe_past_limit(step):
+    def probe_past_limit(self, step):
         """The target lies beyond a limit set by a refused point (the stop rule says so, or
         the estimate sits on that limit: the model clips it there while the seed noise keeps
         the stop rule from calling it beyond): the point halfway between the limit and that
         refused point (bisection towards what the rig can run), or None when the gap is
         below PROBE_GAP_U or no refused point lies beyond that limit."""
+        scale, lo_u, hi_u = self.scale, self.lo_u, self.hi_u
         side = {stopping.BEYOND_LOWER: -1, stopping.BEYOND_UPPER: 1}.get(step.stop)
         if side is None and not step.stop:
             u = float(scale.to_unit(step.estimate))
@@ -122,7 +124,7 @@ def run(study, material, st):
         if side is None:
             return None
         limit = lo_u if side < 0 else hi_u
-        beyond = [float(scale.to_unit(x)) for x, _ in refused]
+        beyond = [float(scale.to_unit(x)) for x, _ in self.refused]
         beyond = [u for u in beyond if (u - limit) * side > 0]
         if not beyond:
             return None
@@ -131,60 +133,82 @@ def run(study, material, st):
             return None
         return float(scale.from_unit(0.5 * (limit + nearest)))
 
-    def decide(runs):
-        return decide_step(p, scale, xs, ys, target, runs, n, lo_u, hi_u, st["out_of_reach_factor"])
+    def decide(self, runs):
+        return decide_step(self.p, self.scale, self.xs, self.ys, self.target, runs, self.n, self.lo_u, self.hi_u,
+                           self.st["out_of_reach_factor"])
 
-    while (x := jr.next_recorded()) is not None:        # a resumed study: the same points again
-        point(x, replay=True)
-    if jr.result and len(set(xs)) >= 2:
-        step = decide(0)
-        for k, v in jr.result.items():                    # the values carried before, exactly
+    def row(self, step):
+        return _row(self.study, self.material, self.st, self.p, self.scale, self.xs, self.ys, step, self.target,
+                    self.response, self.refused, self.lo_u, self.hi_u, self.extra, self.lab_dir)
+
+    def second_point(self, start):
+        """Run points until two differ (the start's response and the physics' slope place the
+        second); '' or why the stage has one point only."""
+        p, scale, n = self.p, self.scale, self.n
+        x0 = round_significant(start)
+        y0 = float(np.mean([y for x, y in zip(self.xs, self.ys) if x == x0] or self.ys))
+        u0 = float(scale.to_unit(x0))
+        while len(set(self.xs)) < 2:
+            if self.runs_left() < n:
+                return "one point only"
+            u1 = second_point_u(u0, y0, self.target.value, p["increasing"], _slope_per_u(self.st, scale, x0, y0),
+                                self.lo_u, self.hi_u)
+            if abs(u1 - u0) < 1e-6:
+                u1 = 0.5 * (u0 + (self.hi_u if u0 < 0.5 else self.lo_u))
+            try:
+                self.point(float(scale.from_unit(u1)))
+            except BudgetSpent:
+                return "study run budget spent"
+        return ""
+
+    def walk(self):
+        """Points where the model says until the stop rule stops (or a probe past a limit,
+        repeats, the budget); the last step."""
+        n = self.n
+        while True:
+            step = self.decide(self.runs_left())
+            probe = self.probe_past_limit(step) if self.runs_left() >= n else None
+            if step.stop and probe is None:
+                return step
+            if probe is not None:
+                self.study.log(f"  the target lies past the limit a refused point set: probing {self.p['label']} = "
+                               f"{probe:.4g}")
+                step.next_x = probe
+            elif self.xs.count(round_significant(step.next_x)) >= REPEAT_RUNS_POINTS * n:
+                step.stop = stopping.REPEATS       # nothing left to learn there
+                return step
+            try:
+                self.point(step.next_x)
+            except BudgetSpent:
+                step = self.decide(0)
+                step.stop = stopping.STUDY_BUDGET
+                return step
+
+
+def run(study, material, st):
+    """Run the stage; returns its row (parameters, responses, met, stop reason, plots)."""
+    p = st["parameter"]
+    study.apply_set(material, st["set"])
+    w = _Walk(study, material, st)
+    while (x := w.jr.next_recorded()) is not None:        # a resumed study: the same points again
+        w.point(x, replay=True)
+    if w.jr.result and len(set(w.xs)) >= 2:
+        step = w.decide(0)
+        for k, v in w.jr.result.items():                    # the values carried before, exactly
             setattr(step, k, v)
-        return _row(study, material, st, p, scale, xs, ys, step, target, response, refused, lo_u, hi_u, extra,
-                    lab_dir)
+        return w.row(step)
     start = p["start"] if p["start"] is not None else min(max(study.current_value(material, p["keys"][0]),
                                                               p["bounds"][0]), p["bounds"][1])
-    if not xs:
-        point(start)
-    x0 = round_significant(start)
-    y0 = float(np.mean([y for x, y in zip(xs, ys) if x == x0] or ys))
-    u0 = float(scale.to_unit(x0))
-    budget_note = ""
-    while len(set(xs)) < 2:
-        if runs_left() < n:
-            budget_note = "one point only"
-            break
-        u1 = second_point_u(u0, y0, target.value, p["increasing"], _slope_per_u(st, scale, x0, y0), lo_u, hi_u)
-        if abs(u1 - u0) < 1e-6:
-            u1 = 0.5 * (u0 + (hi_u if u0 < 0.5 else lo_u))
-        try:
-            point(float(scale.from_unit(u1)))
-        except BudgetSpent:
-            budget_note = "study run budget spent"
-            break
-    if len(set(xs)) < 2:
-        return _one_point_row(study, st, target, response, xs, ys, budget_note)
-    while True:
-        step = decide(runs_left())
-        probe = probe_past_limit(step) if runs_left() >= n else None
-        if step.stop and probe is None:
-            break
-        if probe is not None:
-            study.log(f"  the target lies past the limit a refused point set: probing {p['label']} = {probe:.4g}")
-            step.next_x = probe
-        elif xs.count(round_significant(step.next_x)) >= REPEAT_RUNS_POINTS * n:
-            step.stop = stopping.REPEATS       # nothing left to learn there
-            break
-        try:
-            point(step.next_x)
-        except BudgetSpent:
-            step = decide(0)
-            step.stop = stopping.STUDY_BUDGET
-            break
+    if not w.xs:
+        w.point(start)
+    budget_note = w.second_point(start)
+    if len(set(w.xs)) < 2:
+        return _one_point_row(study, st, w.target, w.response, w.xs, w.ys, budget_note)
+    step = w.walk()
     step.estimate = round_significant(step.estimate)
-    jr.finish({k: getattr(step, k) for k in ("estimate", "low", "high", "tolerance", "band_low", "band_high", "stop",
-                                              "next_x")})
-    return _row(study, material, st, p, scale, xs, ys, step, target, response, refused, lo_u, hi_u, extra, lab_dir)
+    w.jr.finish({k: getattr(step, k) for k in ("estimate", "low", "high", "tolerance", "band_low", "band_high", "stop",
+                                                "next_x")})
+    return w.row(step)
 
 
 def _row(study, material, st, p, scale, xs, ys, step, target, response, refused, lo_u, hi_u, extra, lab_dir):

@@ -43,52 +43,54 @@ def shared_runs(responses, extras):
     return list(groups.values())
 
 
-def run(study, material, st):
-    """Run the stage; returns its row."""
-    label = st["label"]
-    params = st["parameters"]
-    study.overrides[material].update(st["set"])
-    tgts = study.targets[(material, label)]
-    resp = [responses_mod.get(r["response"]) for r in st["responses"]]
-    scales = [Scale(*p["bounds"], log=p["scale"] == "log") for p in params]
-    lab_dir = study.lab_dir(st)
-    n = len(study.seeds)
-    per_point = n * len(resp)
-    runs_at_start = study.runs_requested
-    X, Y, refused = [], [], []
-    widths = [None] * len(resp)          # outputs per response (a vector's length)
+class _Design:
+    """The points of one joint stage so far (X: parameter values per run, Y: every output per
+    run), the points the rig refused and each response's width (outputs per response)."""
 
-    def runs_left():
-        return min(st["max_runs_count"] - (study.runs_requested - runs_at_start), study.runs_left())
+    def __init__(self, study, material, st):
+        self.study, self.material, self.st = study, material, st
+        self.params = st["parameters"]
+        self.tgts = study.targets[(material, st["label"])]
+        self.resp = [responses_mod.get(r["response"]) for r in st["responses"]]
+        self.scales = [Scale(*p["bounds"], log=p["scale"] == "log") for p in self.params]
+        self.lab_dir = study.lab_dir(st)
+        self.per_point = len(study.seeds) * len(self.resp)
+        self.runs_at_start = study.runs_requested
+        self.X, self.Y, self.refused = [], [], []
+        self.widths = [None] * len(self.resp)          # outputs per response (a vector's length)
+        self.jr = study.stage_journal(material, st)
 
-    def extra(xs, r):
-        e = dict(r["rig_overrides"], **st["run_at"])
-        for p, x in zip(params, xs):
+    def runs_left(self):
+        return min(self.st["max_runs_count"] - (self.study.runs_requested - self.runs_at_start), self.study.runs_left())
+
+    def extra(self, xs, r):
+        e = dict(r["rig_overrides"], **self.st["run_at"])
+        for p, x in zip(self.params, xs):
             e.update({k: x for k in p["keys"]})
         return e
 
-    jr = study.stage_journal(material, st)
-
-    def point(xs, replay=False):
+    def point(self, xs, replay=False):
         """Run xs; False when the rig refused it."""
+        study, st, label, resp, widths = self.study, self.st, self.st["label"], self.resp, self.widths
         xs = [round_significant(x) for x in xs]
         if not replay:
-            jr.record(xs)
+            self.jr.record(xs)
         try:
             cols = [None] * len(resp)
-            for group in shared_runs(st["responses"], [extra(xs, r) for r in st["responses"]]):
+            for group in shared_runs(st["responses"], [self.extra(xs, r) for r in st["responses"]]):
                 r0 = st["responses"][group[0]]
                 if len(group) == 1:                       # a seed without a value is left out
-                    vals_of = [study.run_point(material, label, r0["rig"], extra(xs, r0), resp[group[0]], lab_dir)]
+                    vals_of = [study.run_point(self.material, label, r0["rig"], self.extra(xs, r0), resp[group[0]],
+                                               self.lab_dir)]
                 else:                                     # a seed without one value keeps the others (NaN there)
-                    vals_of = study.run_point_responses(material, label, r0["rig"], extra(xs, r0),
-                                                        [resp[j] for j in group], lab_dir)
+                    vals_of = study.run_point_responses(self.material, label, r0["rig"], self.extra(xs, r0),
+                                                        [resp[j] for j in group], self.lab_dir)
                 for j, vals in zip(group, vals_of):
                     vals = [v if isinstance(v, list) else [v] for v in vals]
                     widths[j] = widths[j] or len(vals[0])
                     cols[j] = [[math.nan if v is None else float(v) for v in row] for row in vals]
         except RunError as exc:
-            refused.append((xs, str(exc)))
+            self.refused.append((xs, str(exc)))
             study.log(f"  the rig refused {xs}: no point near it is asked again")
             return False
         # a seed without a value (e.g. a pile too flat for an angle, left out by run_point, or
@@ -96,92 +98,110 @@ def run(study, material, st):
         # model uses its own finite rows
         rows = max(len(c) for c in cols)
         for i in range(rows):
-            X.append(xs)
-            Y.append([v for c, w in zip(cols, widths) for v in (c[i] if i < len(c) else [math.nan] * w)])
+            self.X.append(xs)
+            self.Y.append([v for c, w in zip(cols, widths) for v in (c[i] if i < len(c) else [math.nan] * w)])
         return True
 
-    while (xs := jr.next_recorded()) is not None:        # a resumed study: the same points again
-        point(xs, replay=True)
-    x0 = [p["start"] if p["start"] is not None else
-          min(max(study.current_value(material, p["keys"][0]), p["bounds"][0]), p["bounds"][1]) for p in params]
-    if not X and not refused:
-        point(x0)
-    tols = [(p["tolerance"], p["tolerance_is_percent"]) for p in params]
-
-    def decide(runs):
+    def decide(self, runs):
         # one target per output (a vector response has several), known once a point ran
+        tgts, widths = self.tgts, self.widths
         targets = [t.value for t, w in zip(tgts, widths) for _ in range(w)]
         ses = [t.standard_error for t, w in zip(tgts, widths) for _ in range(w)]
         dofs = [t.standard_error_dof for t, w in zip(tgts, widths) for _ in range(w)]
-        return step_nd(scales, X, Y, targets, ses, tols, runs_left=runs, runs_per_point=per_point,
-                       avoid_x=[x for x, _ in refused], standard_error_dofs=dofs)
+        tols = [(p["tolerance"], p["tolerance_is_percent"]) for p in self.params]
+        return step_nd(self.scales, self.X, self.Y, targets, ses, tols, runs_left=runs, runs_per_point=self.per_point,
+                       avoid_x=[x for x, _ in self.refused], standard_error_dofs=dofs)
 
-    if jr.result:
-        step = decide(0)
-        for k, v in jr.result.items():                    # the values carried before, exactly
-            setattr(step, k, v)
-    else:
-        def first_steps(base):
-            """One step per parameter from base (a tenth of the bounds, inwards; a refused
-            step is tried the other way once)."""
-            u0 = [float(s.to_unit(x)) for s, x in zip(scales, base)]
-            for j in range(len(params)):
-                for sign in ((1, -1) if u0[j] <= 0.5 else (-1, 1)):
-                    u = list(u0)
-                    u[j] = min(1.0, max(0.0, u[j] + sign * FIRST_STEP_U))
-                    xs = [round_significant(float(s.from_unit(v))) for s, v in zip(scales, u)]
-                    if xs in X:                           # run already (replayed)
-                        break
-                    if any(xs == r for r, _ in refused):  # refused already: the other way
-                        continue
-                    if point(xs):
-                        break
+    def first_steps(self, base):
+        """One step per parameter from base (a tenth of the bounds, inwards; a refused
+        step is tried the other way once)."""
+        scales = self.scales
+        u0 = [float(s.to_unit(x)) for s, x in zip(scales, base)]
+        for j in range(len(self.params)):
+            for sign in ((1, -1) if u0[j] <= 0.5 else (-1, 1)):
+                u = list(u0)
+                u[j] = min(1.0, max(0.0, u[j] + sign * FIRST_STEP_U))
+                xs = [round_significant(float(s.from_unit(v))) for s, v in zip(scales, u)]
+                if xs in self.X:                          # run already (replayed)
+                    break
+                if any(xs == r for r, _ in self.refused):  # refused already: the other way
+                    continue
+                if self.point(xs):
+                    break
 
+    def walk(self, x0):
+        """The first design around x0, then points where the model says until the stop rule
+        (or the budget) stops; the last step, its estimate rounded and journalled."""
         try:
-            first_steps(x0)
-            if not X:
-                raise RunError(f"no point of the first design ran: {refused[0][1]}")
-            if len({tuple(x) for x in X}) < 2:            # the start was refused: steps from what ran
-                first_steps(X[0])
+            self.first_steps(x0)
+            if not self.X:
+                raise RunError(f"no point of the first design ran: {self.refused[0][1]}")
+            if len({tuple(x) for x in self.X}) < 2:       # the start was refused: steps from what ran
+                self.first_steps(self.X[0])
             while True:
-                step = decide(runs_left())
+                step = self.decide(self.runs_left())
                 if step.stop:
                     break
-                point(step.next_x)
+                self.point(step.next_x)
         except BudgetSpent:
-            if len({tuple(x) for x in X}) < 2:
+            if len({tuple(x) for x in self.X}) < 2:
                 raise
-            step = decide(0)
+            step = self.decide(0)
             step.stop = stopping.STUDY_BUDGET
         step.estimate = [round_significant(v) for v in step.estimate]
-        jr.finish({k: getattr(step, k) for k in ("estimate", "low", "high", "tolerance", "correlation", "stop")})
+        self.jr.finish({k: getattr(step, k) for k in ("estimate", "low", "high", "tolerance", "correlation", "stop")})
+        return step
+
+    def responses_at(self, step, values):
+        """Each output's model at the estimate, beside its target (the stage row's responses)."""
+        u_est = np.array([[float(s.to_unit(v)) for s, v in zip(self.scales, values)]])
+        out_resp, k = [], 0
+        for r, response, t, w in zip(self.st["responses"], self.resp, self.tgts, self.widths):
+            for e in range(w):
+                m = step.models[k] if k < len(step.models) else None
+                mean, var = m.mean_var(u_est) if m else (np.array([math.nan]), np.array([math.nan]))
+                out_resp.append({"rig": r["rig"], "response": response.name + (f"[{e}]" if response.vector else ""),
+                                 "unit": response.unit, "target": t.value, "band": t.band,
+                                 "standard_error": t.standard_error, "target_source": t.source,
+                                 "at_estimate": float(mean[0]), "at_estimate_sd": float(math.sqrt(var[0])),
+                                 "noise_sd": m.noise_sd if m else math.nan, "noise_dof": m.noise_dof if m else 0})
+                k += 1
+        return out_resp
+
+
+def run(study, material, st):
+    """Run the stage; returns its row."""
+    params = st["parameters"]
+    study.apply_set(material, st["set"])
+    d = _Design(study, material, st)
+    while (xs := d.jr.next_recorded()) is not None:        # a resumed study: the same points again
+        d.point(xs, replay=True)
+    x0 = [p["start"] if p["start"] is not None else
+          min(max(study.current_value(material, p["keys"][0]), p["bounds"][0]), p["bounds"][1]) for p in params]
+    if not d.X and not d.refused:
+        d.point(x0)
+    if d.jr.result:
+        step = d.decide(0)
+        for k, v in d.jr.result.items():                    # the values carried before, exactly
+            setattr(step, k, v)
+    else:
+        step = d.walk(x0)
     values = list(step.estimate)
     for p, v, lo, hi in zip(params, values, step.low, step.high):
         study.set_value(material, p["keys"], v, (v, lo, hi))
-    u_est = np.array([[float(s.to_unit(v)) for s, v in zip(scales, values)]])
-    out_resp, k = [], 0
-    for r, response, t, w in zip(st["responses"], resp, tgts, widths):
-        for e in range(w):
-            m = step.models[k] if k < len(step.models) else None
-            mean, var = m.mean_var(u_est) if m else (np.array([math.nan]), np.array([math.nan]))
-            out_resp.append({"rig": r["rig"], "response": response.name + (f"[{e}]" if response.vector else ""),
-                             "unit": response.unit, "target": t.value, "band": t.band,
-                             "standard_error": t.standard_error, "target_source": t.source,
-                             "at_estimate": float(mean[0]), "at_estimate_sd": float(math.sqrt(var[0])),
-                             "noise_sd": m.noise_sd if m else math.nan, "noise_dof": m.noise_dof if m else 0})
-            k += 1
     row = {"parameters": [{"label": p["label"], "keys": p["keys"], "unit": p["unit"], "scale": p["scale"],
                            "estimate": v, "low": lo, "high": hi, "tolerance": tol,
                            "band_low": math.nan, "band_high": math.nan}
                           for p, v, lo, hi, tol in zip(params, values, step.low, step.high, step.tolerance)],
-           "responses": out_resp, "correlation": step.correlation, "met": step.stop == stopping.WITHIN,
-           "stop_reason": step.stop, "points_count": len({tuple(x) for x in X}),
+           "responses": d.responses_at(step, values), "correlation": step.correlation,
+           "met": step.stop == stopping.WITHIN, "stop_reason": step.stop, "points_count": len({tuple(x) for x in d.X}),
            "message": "; ".join(f"{p['label']}: 95 % interval within +-{max(v - lo, hi - v):.3g} "
                                 f"{unit_label(p['unit'])} (tolerance +-{tol:.3g})"
                                 for p, v, lo, hi, tol in zip(params, values, step.low, step.high, step.tolerance))
-           + (("; the rig refused " + ", ".join(str(x) for x, _ in refused)) if refused else "")}
-    row["plots"] = plots.stage_joint(study, material, st, row, scales, np.array(X), np.array(Y), step, tgts,
-                                     widths, resp)
-    for r, response in zip(st["responses"], resp):
-        row["plots"] += plots.lab_curves(study, material, label, r["rig"], extra(values, r), response, lab_dir)
+           + (("; the rig refused " + ", ".join(str(x) for x, _ in d.refused)) if d.refused else "")}
+    row["plots"] = plots.stage_joint(study, material, st, row, d.scales, np.array(d.X), np.array(d.Y), step, d.tgts,
+                                     d.widths, d.resp)
+    for r, response in zip(st["responses"], d.resp):
+        row["plots"] += plots.lab_curves(study, material, st["label"], r["rig"], d.extra(values, r), response,
+                                         d.lab_dir)
     return row

@@ -148,7 +148,7 @@ def run(study):
         study.section = f"validation/{pred['name']}"
         extra = run_overrides(study.overrides, pred)
         try:
-            results = study._run_seeds(pred["rig"], pred["material"], extra, seeds)
+            results = study.run_seeds(pred["rig"], pred["material"], extra, seeds)
         except RunError as exc:
             rows.append({"prediction": pred["name"], "rig": pred["rig"], "material": pred["material"],
                          "comparisons": [], "error": str(exc)})

@@ -205,24 +205,24 @@ def test_run_seeds_gives_one_result_per_seed_and_replaces_a_refused_seed(tmp_pat
     log = []
     ex = FakeRigs(refuse=lambda job: "no rest" if job["seed"] == 2 else None)
     study = Study(study_file, ex, tmp_path / "out", log=log.append)
-    results = study._run_seeds("aor", "M3-dry", {}, [1, 2])
+    results = study.run_seeds("aor", "M3-dry", {}, [1, 2])
     assert len(results) == 2 and study.last_seeds == [1, 3]      # seed 3: the next above those asked
     assert [j["seed"] for j in ex.asked] == [1, 2, 3] and study.runs_requested == 3
     assert any("replaced by seed 3" in line for line in log)
     with pytest.raises(RunError, match="run"):
-        Study(study_file, FakeRigs(refuse=lambda job: "no rest"), tmp_path / "o2", log=quiet)._run_seeds(
+        Study(study_file, FakeRigs(refuse=lambda job: "no rest"), tmp_path / "o2", log=quiet).run_seeds(
             "aor", "M3-dry", {}, [1, 2, 3])
 
 
 def test_every_stage_runs_through_run_seeds(tmp_path, study_file, monkeypatch):
     """The density stage too: seed replacement and the run budget apply to every run."""
     calls = []
-    original = Study._run_seeds
+    original = Study.run_seeds
 
     def spy(self, rig, material, overrides, seeds, **kw):
         calls.append((rig, list(seeds)))
         return original(self, rig, material, overrides, seeds, **kw)
-    monkeypatch.setattr(Study, "_run_seeds", spy)
+    monkeypatch.setattr(Study, "run_seeds", spy)
     ex = FakeRigs()
     Study(study_file, ex, tmp_path / "out", log=quiet).run()
     assert {rig for rig, _ in calls} == {"fill", "aor"}
