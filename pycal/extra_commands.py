@@ -1,4 +1,4 @@
-"""Commands of the later pipeline stages (calibration, study, the runs table), kept out of cli.py."""
+"""Commands of the later pipeline stages (calibration, study, the runs table, the library), kept out of cli.py."""
 
 
 def register(sub):
@@ -8,6 +8,8 @@ def register(sub):
     register_fit_density(sub)
     register_calibrate(sub)
     register_runs(sub)
+    from .library import register as register_library
+    register_library(sub)
 
 
 def register_runs(sub):
