@@ -187,7 +187,6 @@ class _Walk:
 
 def run(study, material, st):
     """Run the stage; returns its row (parameters, responses, met, stop reason, plots)."""
-    p = st["parameter"]
     study.apply_set(material, st["set"])
     w = _Walk(study, material, st)
     while (x := w.jr.next_recorded()) is not None:        # a resumed study: the same points again
@@ -197,8 +196,7 @@ def run(study, material, st):
         for k, v in w.jr.result.items():                    # the values carried before, exactly
             setattr(step, k, v)
         return w.row(step)
-    start = p["start"] if p["start"] is not None else min(max(study.current_value(material, p["keys"][0]),
-                                                              p["bounds"][0]), p["bounds"][1])
+    start = study.first_value(material, st["parameter"])
     if not w.xs:
         w.point(start)
     budget_note = w.second_point(start)

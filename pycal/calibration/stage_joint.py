@@ -176,8 +176,7 @@ def run(study, material, st):
     d = _Design(study, material, st)
     while (xs := d.jr.next_recorded()) is not None:        # a resumed study: the same points again
         d.point(xs, replay=True)
-    x0 = [p["start"] if p["start"] is not None else
-          min(max(study.current_value(material, p["keys"][0]), p["bounds"][0]), p["bounds"][1]) for p in params]
+    x0 = [study.first_value(material, p) for p in params]
     if not d.X and not d.refused:
         d.point(x0)
     if d.jr.result:

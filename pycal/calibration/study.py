@@ -98,6 +98,14 @@ class Study(Evaluator):
             return self.overrides[material][key]
         return self.start_value(material, key)
 
+    def first_value(self, material, group):
+        """A parameter group's first point: its `start`, else the value the study has reached,
+        inside the group's bounds."""
+        if group["start"] is not None:
+            return group["start"]
+        lo, hi = group["bounds"]
+        return min(max(self.current_value(material, group["keys"][0]), lo), hi)
+
     def stage_journal(self, material, st):
         """The journal of a stage (pycal.calibration.journal), keyed by what it starts from:
         its config, the seeds, its targets and the material's values so far (a stage on a
