@@ -30,7 +30,8 @@ def _study(args):
                                              workers=workers, timeout_s=args.timeout_s),
                                args.replicas, args.replica_layout)
     # (a Dask executor stops the cluster it started when the process exits)
-    return Study(args.config, executor, Path(args.out or runs / "study"), seed_base=args.seed_base), runs
+    return Study(args.config, executor, Path(args.out or runs / "study"), seed_base=args.seed_base,
+                 use_library=args.library), runs
 
 
 def _cmd_calibrate(args):
@@ -84,6 +85,10 @@ def _common_args(s):
     s.add_argument("--seed-base", type=int, default=1,
                    help="first seed of every point: seeds N, N+1, ... (default 1); another base gives an "
                         "independent calibration whose intervals should overlap this one's")
+    s.add_argument("--library", action="store_true",
+                   help="one-parameter stages start from the matching runs already in the runs folder (the library: "
+                        "after a changed lab number, most runs are there); not with another --seed-base on the same "
+                        "runs folder (its runs would not be independent)")
     add_executor_args(s, default_workers="cores, at least seeds_count")
 
 

@@ -132,7 +132,7 @@ class Evaluator:
         angle before and after the vibration, both from one surcharge run): one list per
         response, in the order of self.last_seeds, NaN where a seed has no value for that
         response (RunError when more than one seed in three has none for any response)."""
-        key = (material, stage, rig, json.dumps(extra, sort_keys=True))
+        key = self.point_key(material, stage, rig, extra)
         used = self._stage_seeds.setdefault((material, stage, rig), [])
         count = count or len(self.seeds)
         seeds = self.seeds[:count] if not used else list(range(max(used) + 1, max(used) + 1 + count))
@@ -144,20 +144,31 @@ class Evaluator:
         # the runs behind the point (its pictures and lab-curve plots): those with a value to show
         self.point_results.setdefault(key, []).extend(
             r for seed, r in zip(self.last_seeds, results) if any(seed not in m for m in missing))
-        params = {k: v for k, v in extra.items() if not k.startswith("rig.")}
         for response, vals, miss in zip(responses, values, missing):
             kept = [(seed, v) for seed, v in zip(self.last_seeds, vals) if seed not in miss]
-            for seed, v in kept:
-                self.runs.append({"material": material, "stage": stage, "rig": rig, "parameters": params,
-                                  "seed": seed, "response": response.name, "value": v})
-            scalar = [v for _, v in kept if not isinstance(v, list)]
-            m, s = mean_std(scalar) if scalar else (math.nan, math.nan)
-            self.points.append({"material": material, "stage": stage, "rig": rig, "parameters": params,
-                                "response": response.name, "mean": m, "std": s, "n": len(kept),
-                                "seeds": [seed for seed, _ in kept]})
-            shown = f"{m:.4g} +/- {s:.2g}" if scalar else f"{len(kept)} vectors"
-            self.log(f"  {format_params(params)} -> {response.name} {shown} (n {len(kept)}; {self.progress_text()})")
+            self.book_point(material, stage, rig, extra, response, kept)
         return values
+
+    @staticmethod
+    def point_key(material, stage, rig, extra):
+        """The key of a point's results in point_results."""
+        return material, stage, rig, json.dumps(extra, sort_keys=True)
+
+    def book_point(self, material, stage, rig, extra, response, kept, note=""):
+        """Note one point's values [(seed, value)] of a response in the study's runs and points
+        (runs.csv, history.csv) and the log line."""
+        params = {k: v for k, v in extra.items() if not k.startswith("rig.")}
+        for seed, v in kept:
+            self.runs.append({"material": material, "stage": stage, "rig": rig, "parameters": params,
+                              "seed": seed, "response": response.name, "value": v})
+        scalar = [v for _, v in kept if not isinstance(v, list)]
+        m, s = mean_std(scalar) if scalar else (math.nan, math.nan)
+        self.points.append({"material": material, "stage": stage, "rig": rig, "parameters": params,
+                            "response": response.name, "mean": m, "std": s, "n": len(kept),
+                            "seeds": [seed for seed, _ in kept]})
+        shown = f"{m:.4g} +/- {s:.2g}" if scalar else f"{len(kept)} vectors"
+        self.log(f"  {format_params(params)} -> {response.name} {shown} (n {len(kept)}; "
+                 f"{note or self.progress_text()})")
 
     def progress_text(self):
         """'9/18 runs; left <= ~35 min': runs of the stage / its budget, and the time

@@ -25,7 +25,7 @@ from .stages import calibrates
 STAGE_COLUMNS = ["material", "stage", "kind", "parameter", "parameter_unit", "keys", "estimate", "interval_low",
                  "interval_high", "tolerance", "met", "stop_reason", "runs_requested", "runs_simulated",
                  "points_count", "elapsed_s", "response", "response_unit", "target", "target_band",
-                 "response_at_estimate", "seed_noise_sd", "message"]
+                 "response_at_estimate", "seed_noise_sd", "message", "runs_from_library"]
 POINT_COLUMNS = ["material", "stage", "rig", "parameters", "response", "mean", "std", "n", "seeds"]
 RUN_COLUMNS = ["material", "stage", "rig", "parameters", "seed", "response", "value"]
 JOB_COLUMNS = ["section", "material", "rig", "seed", "job_id", "status", "batch_job_id"]
@@ -48,6 +48,7 @@ def stage_table(rows):
         common = {"material": r["material"], "stage": r["stage"], "kind": r["kind"], "met": r["met"],
                   "stop_reason": r["stop_reason"], "runs_requested": r.get("runs_requested"),
                   "runs_simulated": r.get("runs_simulated"), "points_count": r.get("points_count"),
+                  "runs_from_library": r.get("runs_from_library", 0),
                   "elapsed_s": r.get("elapsed_s"), "message": r.get("message", ""),
                   "response": "; ".join(x.get("response", "") for x in resp),
                   "response_unit": first.get("unit", ""), "target": first.get("target", math.nan),

@@ -25,7 +25,7 @@ from ..post import responses as responses_mod
 from ..stats import stopping
 from ..stats.scales import Scale, round_significant
 from ..stats.sequential import second_point_u, step_1d
-from . import plots
+from . import library_start, plots
 from .names import unit_label
 
 PROBE_GAP_U = 0.02     # bisection towards a refused point stops at this gap (fraction of the bounds)
@@ -73,6 +73,7 @@ class _Walk:
         self.xs, self.ys, self.refused = [], [], []
         self.lo_u, self.hi_u = 0.0, 1.0
         self.jr = study.stage_journal(material, st)
+        self.from_library = 0                # runs taken from the library (library_start.py)
 
     def runs_left(self):
         return min(self.st["max_runs_count"] - (self.study.runs_requested - self.runs_at_start), self.study.runs_left())
@@ -138,8 +139,10 @@ class _Walk:
                            self.st["out_of_reach_factor"])
 
     def row(self, step):
-        return _row(self.study, self.material, self.st, self.p, self.scale, self.xs, self.ys, step, self.target,
-                    self.response, self.refused, self.lo_u, self.hi_u, self.extra, self.lab_dir)
+        row = _row(self.study, self.material, self.st, self.p, self.scale, self.xs, self.ys, step, self.target,
+                   self.response, self.refused, self.lo_u, self.hi_u, self.extra, self.lab_dir)
+        row["runs_from_library"] = self.from_library
+        return row
 
     def second_point(self, start):
         """Run points until two differ (the start's response and the physics' slope place the
@@ -189,6 +192,10 @@ def run(study, material, st):
     """Run the stage; returns its row (parameters, responses, met, stop reason, plots)."""
     study.apply_set(material, st["set"])
     w = _Walk(study, material, st)
+    for x, v in library_start.take(study, material, st, w.jr, w.extra, w.response, w.lab_dir):
+        w.xs.append(x)                                     # runs already made at this stage's points
+        w.ys.append(v)
+    w.from_library = len(w.xs)
     while (x := w.jr.next_recorded()) is not None:        # a resumed study: the same points again
         w.point(x, replay=True)
     if w.jr.result and len(set(w.xs)) >= 2:

@@ -34,15 +34,20 @@ SEED_SCHEME = "fresh seeds at every point"   # in the stage fingerprint: journal
 class Study(Evaluator):
     """Runs a study config with an executor (runner.LocalPool or runner.YadeBatch).
 
-    seed_base: the first seed of every point (seeds seed_base, seed_base + 1, ...)."""
+    seed_base: the first seed of every point (seeds seed_base, seed_base + 1, ...);
+    use_library: a one-parameter stage starts from the matching runs already in the runs
+    folder (pycal/calibration/library_start.py); False (default): every stage from its own runs
+    only, so that a study run again in a new output folder on the same runs folder asks for the
+    same jobs, and a study of another seed base stays independent of this one."""
 
-    def __init__(self, config_path, executor, out_dir, log=print, seed_base=1):
+    def __init__(self, config_path, executor, out_dir, log=print, seed_base=1, use_library=False):
         self.config_path = Path(config_path)
         self.cfg = load_study(config_path)
         self.out = Path(out_dir) / self.cfg["name"]
         if isinstance(seed_base, bool) or not isinstance(seed_base, int) or seed_base < 0:
             raise PycalError(f"--seed-base {seed_base!r}: must be a whole number >= 0")
         self.seed_base = seed_base
+        self.use_library = use_library   # one-parameter stages start from the runs already made (library_start.py)
         super().__init__(executor, log, self.seeds_from_base(self.cfg["seeds_count"]), self.cfg.get("max_runs_count"),
                          f"{self.config_path}: max_runs_count")
         self.overrides = {m: {} for m in self.cfg["materials"]}
@@ -171,6 +176,7 @@ class Study(Evaluator):
                             "runs_simulated": simulated, "elapsed_s": round(elapsed, 1),
                             "material_set": st.get("material_set")})
                 row.setdefault("plots", [])
+                row.setdefault("runs_from_library", 0)
                 row["held"] = held
                 row["matches_lab"] = matches_lab(row)
                 row["gallery"] = gallery.stage_pictures(self, material, st, row) if kind.calibrates else []
