@@ -4,33 +4,16 @@ a changed lab angle the density stage simulates nothing and the rolling stage st
 the earlier study's runs; no run counts twice; a resumed study takes the same runs."""
 import json
 
-from fake_rigs import FakeRigs
+from fake_rigs import ROLLING_STUDY_HEAD, FakeRigs
 from pycal.calibration.study import Study
 
-STUDY = """
-name: lib
-seeds_count: 3
-materials:
-  M3-dry:
-    - stage: density
+DENSITY_STAGE = """    - stage: density
       rig: fill
-      target: {{band_percent: 1.0}}
-      parameter: {{bounds: [1500.0, 9000.0], tolerance_kg_m3: 30.0}}
+      target: {band_percent: 1.0}
+      parameter: {bounds: [1500.0, 9000.0], tolerance_kg_m3: 30.0}
       max_runs_count: 24
-    - stage: rolling_resistance
-      rig: aor
-      response: aor_mean_deg
-      target: {{value: {angle}, band_deg: 1.0}}
-      parameter:
-        keys: [interactions.M3-dry.rolling_resistance_coefficient,
-               interactions.steel.rolling_resistance_coefficient,
-               interactions.pvc.rolling_resistance_coefficient]
-        start: 0.35
-        bounds: [0.05, 1.5]
-        response_increases: true
-        tolerance_coefficient: 0.02
-      max_runs_count: 30
 """
+LAB_TARGET = "target: {sample: fines_dry, test: angle_of_repose, band_deg: 1.0}"
 
 
 class WritingFake(FakeRigs):
@@ -47,8 +30,11 @@ class WritingFake(FakeRigs):
 
 
 def config(tmp_path, angle):
+    """The fake AoR study of fake_rigs.py with a density stage first and the lab angle `angle`."""
+    assert LAB_TARGET in ROLLING_STUDY_HEAD
+    text = ROLLING_STUDY_HEAD.replace(LAB_TARGET, f"target: {{value: {angle}, band_deg: 1.0}}")
     p = tmp_path / f"lib-{angle}.yaml"
-    p.write_text(STUDY.format(angle=angle))
+    p.write_text("name: lib\n" + text.replace("  M3-dry:\n", "  M3-dry:\n" + DENSITY_STAGE, 1))
     return p
 
 
