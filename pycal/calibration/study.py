@@ -2,8 +2,9 @@
 
 The driver: it runs the rigs, keeps every run, and asks pycal.stats what the runs say
 (estimate, 95 % interval, stop or where next), the way GrainLearning keeps its
-inference apart from its models. Stage kinds and config: pycal.calibration.study_config;
-one-parameter stages: stage_1d; coupled parameters: stage_joint; outputs: outputs.
+inference apart from its models. The study config: study_config; the stage kinds (their
+checks and runners): stages/; one-parameter stages run in stage_1d, coupled parameters in
+stage_joint; outputs: outputs.
 
 Every run goes through `Evaluator.run_seeds` (pycal/calibration/evaluator.py: one result
 per seed asked, a refused seed replaced by the next unused one, the run budget counted
