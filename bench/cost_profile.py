@@ -17,7 +17,6 @@ not timed. Results written before phase_cpu existed show only their totals.
 """
 import argparse
 import csv
-import json
 import statistics
 import sys
 from collections import defaultdict
@@ -25,22 +24,22 @@ from pathlib import Path
 
 sys.path.insert(0, str(Path(__file__).resolve().parent.parent))
 from pycal.files import write_text  # noqa: E402
-from pycal.runs_index import runs_table  # noqa: E402
+from pycal.runs_index import runs_with_results  # noqa: E402
 
 
 def load(study_dir, runs_dir):
-    """[(run {'section', 'rig'}, result.json or None, share of the folder's cost)], one per distinct
-    job the study asked for (pycal.runs_index; a run two sections asked for counts in the first)."""
-    df = runs_table(runs_dir, study_dir)
+    """[(run {'section', 'rig'}, result or None, share of its YADE process's cost)], one per distinct
+    job the study asked for (pycal.runs_index; a run two sections asked for counts in the first).
+    A replica's result carries its batch's provenance and seeds: its share is one of them."""
     rows = []
-    for r in df[df["stage"] != ""].to_dict("records"):
+    for r, result in runs_with_results(runs_dir, study_dir):
+        if not r["stage"]:
+            continue
         run = {"section": r["stage"].split(";")[0], "rig": r["rig"]}
-        if r["status"] != "ok":
+        if result is None:
             rows.append((run, None, 1.0))
             continue
-        folder = Path(r["folder"]).parent if r["batch_job_id"] else Path(r["folder"])
-        result = json.loads((folder / "result.json").read_text())
-        rows.append((run, result, 1.0 / max(1, len(result.get("replicas") or [None]))))
+        rows.append((run, result, 1.0 / len(result["provenance"].get("batch_seeds") or [None])))
     return rows
 
 

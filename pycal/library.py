@@ -24,7 +24,7 @@ from .errors import ConfigError
 from .files import atomic_path
 from .jobs import content_digest, resolve_job
 from .rig_contract import BATCH_SEEDS_KEY, LAYOUT_KEY
-from .runs_index import ID_COLUMNS, ok_results
+from .runs_index import ID_COLUMNS, check_runs_dir, ok_results
 
 LIBRARY_FILE = "library.csv"           # imported rows, in the runs folder
 KEY_COLUMNS = ["point_id", "job_id", "rig", "material", "seed", "overrides_json"]
@@ -154,8 +154,7 @@ def summary_lines(df, flags):
 
 def cli(args):
     """`pycal library`: list (default), --export FILE or --import FILE."""
-    if not Path(args.runs).is_dir():
-        raise ConfigError("RUNS_DIR", str(args.runs), "no such folder (a runs folder, e.g. runs/)")
+    check_runs_dir(args.runs)
     if args.import_file:
         read, added = import_rows(args.runs, args.import_file)
         print(f"{args.import_file}: {read} rows read, {added} new in {Path(args.runs) / LIBRARY_FILE}")

@@ -63,8 +63,9 @@ def _row(job, status, folder, result=None, message="", share=1.0, batch_id=""):
     return row
 
 
-def _folder_rows(folder):
-    """Rows of one job folder (a batch folder gives one row per replica)."""
+def _folder_runs(folder):
+    """[(row, result or None)] of one job folder (a batch folder: one per replica, its result
+    expanded as a lone run's)."""
     from .replicas import expand
     from .rig_contract import BATCH_SEEDS_KEY, replica_dir_name, seed_job
     name = folder.name
@@ -72,16 +73,16 @@ def _folder_rows(folder):
     job = (result or {}).get("job") or _read_json(folder / JOB_FILE) or {}
     if result is not None and "replicas" in result:
         n = max(1, len(result["replicas"]))
-        rows = []
+        out = []
         for seed, res, failure in expand(result):
             own = folder / replica_dir_name(seed)
             if res is None:
-                rows.append(_row(seed_job(job, seed), "failed", own, message=failure, batch_id=job["job_id"]))
+                out.append((_row(seed_job(job, seed), "failed", own, message=failure, batch_id=job["job_id"]), None))
             else:
-                rows.append(_row(res["job"], "ok", own, res, share=1.0 / n, batch_id=job["job_id"]))
-        return rows
+                out.append((_row(res["job"], "ok", own, res, share=1.0 / n, batch_id=job["job_id"]), res))
+        return out
     if result is not None:
-        return [_row(job, "ok", folder, result)]
+        return [(_row(job, "ok", folder, result), result)]
     if not job:
         return []
     refusal = folder / RIG_FAILURE_FILE
@@ -89,9 +90,9 @@ def _folder_rows(folder):
     message = refusal.read_text().strip() if refusal.is_file() else ""
     seeds = job.get(BATCH_SEEDS_KEY)
     if seeds:
-        return [_row(seed_job(job, s), status, folder / replica_dir_name(s), message=message, batch_id=job["job_id"])
-                for s in seeds]
-    return [_row(job, status, folder, message=message)]
+        return [(_row(seed_job(job, s), status, folder / replica_dir_name(s), message=message,
+                      batch_id=job["job_id"]), None) for s in seeds]
+    return [(_row(job, status, folder, message=message), None)]
 
 
 def study_jobs(study_dir):
@@ -108,11 +109,13 @@ def study_jobs(study_dir):
     return {k: (";".join(v), r) for k, (v, r) in out.items()}
 
 
-def runs_table(runs_dir, study_dir=None, rig=None, material=None):
-    """Every run under `runs_dir` (optionally one rig / material) as a DataFrame (module doc),
-    sorted by rig, material, job id. A failed attempt whose job has a result since is left out."""
+def runs_with_results(runs_dir, study_dir=None, rig=None, material=None):
+    """[(row, result or None)] of every run under `runs_dir` (optionally one rig / material),
+    sorted by rig, material, job id: the row as in runs_table (module doc), the result shaped
+    as a lone run's result.json (a replica's expanded from its batch, its job under 'job').
+    Each result.json is read once. A failed attempt whose job has a result since is left out."""
     runs_dir = Path(runs_dir)
-    rows = []
+    pairs = []
     for name in rigs.names():
         if rig is not None and name != rig:
             continue
@@ -125,52 +128,52 @@ def runs_table(runs_dir, study_dir=None, rig=None, material=None):
                 continue
             if folder.name.endswith(".failed") and folder.name[:-len(".failed")] in done:
                 continue
-            rows += _folder_rows(folder)
+            pairs += _folder_runs(folder)
     if study_dir is not None:
         asked = study_jobs(study_dir)       # a replica is listed under its lone job's id and its batch
         by_batch = {(r.get("batch_job_id"), str(r["seed"])): j for j, (_, r) in asked.items() if r.get("batch_job_id")}
         found = set()
-        for r in rows:
+        for r, _ in pairs:
             j = r["job_id"] if r["job_id"] in asked else by_batch.get((r["batch_job_id"], str(r["seed"])))
             r["stage"] = asked[j][0] if j else ""
             found.add(j)
-        rows += [{"job_id": j, "rig": r["rig"], "material": r["material"], "seed": int(r["seed"]), "status": "missing",
-                  "message": f"asked by the study ({r['status']}), no job folder in {runs_dir}", "stage": sections,
-                  "batch_job_id": r.get("batch_job_id") or ""}
-                 for j, (sections, r) in asked.items()
-                 if j not in found and (rig is None or r["rig"] == rig)]
+        pairs += [({"job_id": j, "rig": r["rig"], "material": r["material"], "seed": int(r["seed"]),
+                    "status": "missing", "message": f"asked by the study ({r['status']}), no job folder in {runs_dir}",
+                    "stage": sections, "batch_job_id": r.get("batch_job_id") or ""}, None)
+                  for j, (sections, r) in asked.items()
+                  if j not in found and (rig is None or r["rig"] == rig)]
     if material is not None:
-        rows = [r for r in rows if r["material"] == material]
-    df = pd.DataFrame(rows, columns=ID_COLUMNS if not rows else None)
-    if df.empty:
+        pairs = [(r, res) for r, res in pairs if r["material"] == material]
+    return sorted(pairs, key=lambda p: (p[0]["rig"], p[0]["material"], p[0]["job_id"]))
+
+
+def runs_table(runs_dir, study_dir=None, rig=None, material=None):
+    """Every run under `runs_dir` (optionally one rig / material) as a DataFrame (module doc),
+    sorted by rig, material, job id. A failed attempt whose job has a result since is left out."""
+    rows = [r for r, _ in runs_with_results(runs_dir, study_dir, rig, material)]
+    if not rows:
         return pd.DataFrame(columns=ID_COLUMNS)
+    df = pd.DataFrame(rows)
     for c in ID_COLUMNS:
         if c not in df.columns:
             df[c] = None
-    df[["message", "batch_job_id", "git_commit", "yade_version", "finished_utc", "folder", "stage"]] = \
-        df[["message", "batch_job_id", "git_commit", "yade_version", "finished_utc", "folder", "stage"]].fillna("")
+    text = ["message", "batch_job_id", "git_commit", "yade_version", "finished_utc", "folder", "stage"]
+    df[text] = df[text].fillna("")
     sets = sorted(c for c in df.columns if c.startswith(SET_PREFIX))
     rest = [c for c in df.columns if c not in ID_COLUMNS and c not in sets]
-    df = df[ID_COLUMNS + sets + rest]
-    return df.sort_values(["rig", "material", "job_id"], kind="stable").reset_index(drop=True)
+    return df[ID_COLUMNS + sets + rest].reset_index(drop=True)
 
 
 def ok_results(runs_dir, rig=None, material=None):
-    """[(row, result)] of every ok run, in the table's order: the result shaped as a lone run's
-    result.json (a replica's from its batch, pycal.replicas.expand), its job under 'job'."""
-    from .replicas import expand
-    df = runs_table(runs_dir, rig=rig, material=material)
-    out, batches = [], {}
-    for row in df[df["status"] == "ok"].to_dict("records"):
-        folder = Path(row["folder"])
-        if row["batch_job_id"]:
-            folder = folder.parent                      # the batch's folder holds the one result.json
-            if folder not in batches:
-                batches[folder] = {seed: res for seed, res, _ in expand(_read_json(folder / RESULT_FILE))}
-            out.append((row, batches[folder][row["seed"]]))
-        else:
-            out.append((row, _read_json(folder / RESULT_FILE)))
-    return out
+    """[(row, result)] of every ok run, in the table's order (runs_with_results)."""
+    return [(r, res) for r, res in runs_with_results(runs_dir, rig=rig, material=material) if r["status"] == "ok"]
+
+
+def check_runs_dir(path):
+    """A ConfigError naming RUNS_DIR when `path` is not a folder."""
+    from .errors import ConfigError
+    if not Path(path).is_dir():
+        raise ConfigError("RUNS_DIR", str(path), "no such folder (a runs folder, e.g. runs/)")
 
 
 def job_files(runs_dir, rig, material=None, status=None):
@@ -202,8 +205,7 @@ def cli(args):
     """`pycal runs`: print the table's main columns and the counts; --csv writes every column."""
     from .errors import ConfigError
     from .files import atomic_path
-    if not Path(args.runs).is_dir():
-        raise ConfigError("RUNS_DIR", str(args.runs), "no such folder (a runs folder, e.g. runs/)")
+    check_runs_dir(args.runs)
     if args.study and not (Path(args.study) / "jobs.csv").is_file():
         raise ConfigError("--study", str(args.study), "no jobs.csv there (a study's output folder, e.g. "
                                                       "runs/study/zinc_ore)")
