@@ -149,6 +149,10 @@ class Evaluator:
             self.book_point(material, stage, rig, extra, response, kept)
         return values
 
+    def mark_seeds_used(self, material, stage, rig, seeds):
+        """Seeds a stage's later points on `rig` must not take again (runs it has from elsewhere)."""
+        self._stage_seeds.setdefault((material, stage, rig), []).extend(seeds)
+
     @staticmethod
     def point_key(material, stage, rig, extra):
         """The key of a point's results in point_results."""

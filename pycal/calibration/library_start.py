@@ -10,29 +10,19 @@ journalled before (its points or its result) takes none. Joint stages do not sta
 library yet.
 """
 import math
-from pathlib import Path
 
 from ..errors import ConfigError
-from ..executors.base import wrapped_chain
 from ..jobs import resolve_job
 from ..library import point_id
 from ..runs_index import ok_results
-
-
-def runs_dir_of(executor):
-    """The runs folder the executor caches its jobs in (through wrappers), or None."""
-    for e in wrapped_chain(executor):
-        d = getattr(e, "runs_dir", None)
-        if d is not None and Path(d).is_dir():
-            return Path(d)
-    return None
+from .run_pictures import runs_dir_of
 
 
 def matching_runs(study, material, st, extra_of):
     """[(x, seed, job_id, result)] of the runs folder's runs that this stage would have run at
     x (inside its bounds) with that seed, sorted by x, seed and job id."""
     runs_dir = runs_dir_of(study.executor)
-    if runs_dir is None:
+    if runs_dir is None or not runs_dir.is_dir():
         return []
     p, rig, label = st["parameter"], st["rig"], st["label"]
     lo, hi = p["bounds"]
@@ -82,7 +72,7 @@ def take(study, material, st, jr, extra_of, response, lab_dir):
         out.append((x, v))
         by_x.setdefault(x, []).append((seed, v, res))
     label, rig = st["label"], st["rig"]
-    study._stage_seeds.setdefault((material, label, rig), []).extend(seed for _, seed, _, _ in runs)
+    study.mark_seeds_used(material, label, rig, [seed for _, seed, _, _ in runs])
     for x, kept in by_x.items():
         extra = extra_of(x)
         study.point_results.setdefault(study.point_key(material, label, rig, extra), []).extend(r for _, _, r in kept)
