@@ -147,15 +147,15 @@ def render(rec):
              "| runs |", "|---|---|---|---|---|---|---|---|"]
     for s in rec["stages"]:
         unit = f" {s['unit']}" if s["unit"] and s["unit"] not in ("-", "coefficient", "fraction") else ""
-        if not calibrates(s["kind"]):
+        calibrated = calibrates(s["kind"])
+        if not calibrated:
             est = f"{_num(s['estimate'])}{unit} (inherited)"
         else:
             est = f"{_num(s['estimate'])} [{_num(s['low'])}, {_num(s['high'])}]{unit}"
         tol = f"+-{_num(s['tolerance'])}" if _finite(s.get("tolerance")) else "-"
-        precise = "-" if not calibrates(s["kind"]) else (
-            "**yes**" if s["precise_enough"] else f"no ({s['stop_reason']})")
+        precise = "-" if not calibrated else ("**yes**" if s["precise_enough"] else f"no ({s['stop_reason']})")
         lines.append(f"| {s['material']} | {s['stage']} | {s['parameter']} | {est} | {tol} | "
-                     f"{'-' if not calibrates(s['kind']) else _yes(s['matches_lab'])} | {precise} | "
+                     f"{_yes(s['matches_lab']) if calibrated else '-'} | {precise} | "
                      f"{s['runs'] if s['runs'] is not None else '-'} |")
     if rec["validation"]:
         lines += ["", "| prediction (nothing fitted) | response | predicted: seed mean +- SD (n) | lab +- band | inside |",

@@ -99,9 +99,7 @@ def aor_seed_angles(study, material, st, row):
     sector count and the doubtful flank fits, and the lab's own left / right of the
     stage's target sample.
     {} for a stage that is not read from a pile."""
-    reads = [(st["rig"], st.get("response"), st.get("target"))] if st.get("rig") else [
-        (r["rig"], r["response"], r.get("target")) for r in st.get("responses") or []]
-    reads = [(rig, t) for rig, resp, t in reads if resp == "aor_mean_deg"]
+    reads = [(r["rig"], r.get("target")) for r in st["responses"] if r["response"] == "aor_mean_deg"]
     points = _chosen_points(row)
     if not reads or not points:
         return {}

@@ -95,5 +95,5 @@ def load_study(path):
 
 
 def stage_rigs(st):
-    """The rigs a normalized stage runs: its `rig`, or its responses' rigs (joint); [] for an inherit."""
-    return [st["rig"]] if st.get("rig") else [r["rig"] for r in st.get("responses", [])]
+    """The rigs a normalized stage runs: its responses' rigs ([] for an inherit)."""
+    return [r["rig"] for r in st["responses"]]
